@@ -1,0 +1,74 @@
+#pragma once
+/// @file
+/// Connectivity of a triangle mesh: unique edges, incidences, adjacency, components.
+/// Built once from the faces; positions live elsewhere (they change every step).
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace clothcd {
+
+using Face = std::array<int, 3>;
+using Edge = std::array<int, 2>;  ///< (smaller vertex id, larger vertex id)
+
+/// Validated topology. Construction throws clothcd::InputError naming the face and what is wrong
+/// for an index out of range or a face that repeats a vertex. Duplicate faces and non-manifold
+/// edges are allowed and counted.
+class Topology {
+ public:
+  Topology() = default;
+  Topology(std::vector<Face> faces, int num_vertices);
+
+  [[nodiscard]] int num_vertices() const { return num_vertices_; }
+  [[nodiscard]] int num_faces() const { return static_cast<int>(faces_.size()); }
+  [[nodiscard]] int num_edges() const { return static_cast<int>(edges_.size()); }
+
+  [[nodiscard]] const std::vector<Face>& faces() const { return faces_; }
+  /// Unique undirected edges, sorted by (larger id, smaller id): the numbering of the
+  /// cloth_ball candidate files.
+  [[nodiscard]] const std::vector<Edge>& edges() const { return edges_; }
+
+  /// Edge ids of face f: edge k joins faces()[f][k] and faces()[f][(k + 1) % 3].
+  [[nodiscard]] const std::array<int, 3>& face_edges(int f) const { return face_edges_[f]; }
+  /// Faces incident to edge e (1 on a boundary, 2 inside, more when non-manifold).
+  [[nodiscard]] std::span<const int> edge_faces(int e) const;
+  /// Faces incident to vertex v, ascending.
+  [[nodiscard]] std::span<const int> vertex_faces(int v) const;
+  /// Edges incident to vertex v, ascending.
+  [[nodiscard]] std::span<const int> vertex_edges(int v) const;
+  /// Id of the edge joining a and b, or -1.
+  [[nodiscard]] int find_edge(int a, int b) const;
+
+  /// Edge-connected component of each face (faces sharing an edge are connected), 0-based and
+  /// numbered in order of their smallest face id.
+  [[nodiscard]] int num_components() const { return num_components_; }
+  [[nodiscard]] int face_component(int f) const { return face_component_[f]; }
+
+  /// True when faces f and g share at least one vertex.
+  [[nodiscard]] bool faces_share_vertex(int f, int g) const;
+
+  [[nodiscard]] int num_boundary_edges() const { return num_boundary_edges_; }
+  [[nodiscard]] int num_nonmanifold_edges() const { return num_nonmanifold_edges_; }
+  [[nodiscard]] int num_duplicate_faces() const { return num_duplicate_faces_; }
+  /// Vertices used by no face.
+  [[nodiscard]] int num_isolated_vertices() const { return num_isolated_vertices_; }
+
+ private:
+  int num_vertices_ = 0;
+  std::vector<Face> faces_;
+  std::vector<Edge> edges_;
+  std::vector<std::array<int, 3>> face_edges_;
+  std::vector<int> edge_face_offsets_, edge_face_ids_;      // CSR
+  std::vector<int> vertex_face_offsets_, vertex_face_ids_;  // CSR
+  std::vector<int> vertex_edge_offsets_, vertex_edge_ids_;  // CSR
+  std::vector<int> face_component_;
+  int num_components_ = 0;
+  int num_boundary_edges_ = 0;
+  int num_nonmanifold_edges_ = 0;
+  int num_duplicate_faces_ = 0;
+  int num_isolated_vertices_ = 0;
+};
+
+}  // namespace clothcd
