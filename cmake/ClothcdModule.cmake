@@ -4,7 +4,7 @@
 set_property(GLOBAL PROPERTY CLOTHCD_MODULES "")
 
 function(clothcd_module name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;USES;LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "STANDALONE" "" "SOURCES;USES;LIBS" ${ARGN})
   set(target clothcd_${name})
   add_library(${target} OBJECT ${ARG_SOURCES})
   target_include_directories(${target} PUBLIC
@@ -17,7 +17,10 @@ function(clothcd_module name)
   if(BUILD_SHARED_LIBS)
     set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   endif()
-  set_property(GLOBAL APPEND PROPERTY CLOTHCD_MODULES ${name})
+  # STANDALONE modules (the simulator) are not part of the `clothcd` library.
+  if(NOT ARG_STANDALONE)
+    set_property(GLOBAL APPEND PROPERTY CLOTHCD_MODULES ${name})
+  endif()
   set_property(TARGET ${target} PROPERTY CLOTHCD_USES ${ARG_USES})
 endfunction()
 
