@@ -48,6 +48,8 @@ class Topology {
 
   /// True when faces f and g share at least one vertex.
   [[nodiscard]] bool faces_share_vertex(int f, int g) const;
+  /// Faces other than f sharing an edge with f, ascending and unique.
+  [[nodiscard]] std::vector<int> face_neighbors(int f) const;
 
   [[nodiscard]] int num_boundary_edges() const { return num_boundary_edges_; }
   [[nodiscard]] int num_nonmanifold_edges() const { return num_nonmanifold_edges_; }
