@@ -25,10 +25,10 @@ inline std::optional<std::filesystem::path> data_path(const std::filesystem::pat
 }  // namespace clothcd::test
 
 /// Declares `var` as the data path of `sub`, or skips the test when that data is absent.
-#define CLOTHCD_REQUIRE_DATA(var, sub)                                                          \
-  const auto var##_opt = ::clothcd::test::data_path(sub);                                       \
-  if (!var##_opt) {                                                                             \
-    GTEST_SKIP() << "test data " << (::clothcd::test::data_root() / (sub)).string()             \
+#define CLOTHCD_REQUIRE_DATA(var, sub)                                                         \
+  const auto var##_opt = ::clothcd::test::data_path(sub);                                      \
+  if (!var##_opt) {                                                                            \
+    GTEST_SKIP() << "test data " << (::clothcd::test::data_root() / (sub)).string()            \
                  << " not found; set CLOTHCD_DATA to the shared data folder to run this test"; \
-  }                                                                                             \
+  }                                                                                            \
   const std::filesystem::path& var = *var##_opt

@@ -18,6 +18,7 @@ class InputError : public std::runtime_error {
 };
 
 /// "file:line: what" (line 0 omits the line).
-[[nodiscard]] InputError input_error(std::string_view file, std::size_t line, std::string_view what);
+[[nodiscard]] InputError input_error(std::string_view file, std::size_t line,
+                                     std::string_view what);
 
 }  // namespace clothcd
