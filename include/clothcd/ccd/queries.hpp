@@ -3,8 +3,14 @@
 /// Elementary continuous collision queries over one linear motion t in [0, 1]: a vertex against a
 /// face (VF) and an edge against an edge (EE). Names follow ipc-toolkit: _t0/_t1 are the start and
 /// end of the step.
+///
+/// Both kernels are conservative: they never miss a contact (docs/ccd.md gives the argument). A
+/// hit certifies that the features came within sqrt(3) * (thickness + tolerance * L) of each other,
+/// where L is the query's extent (largest coordinate range of its eight points).
 
 #include <Eigen/Core>
+
+#include <cstdint>
 
 namespace clothcd {
 
@@ -24,12 +30,33 @@ struct CcdOptions {
   /// Use the cubic fast path (Bernstein coplanarity cubic + NP filter) where it is well
   /// conditioned; false runs the conservative inclusion solver alone.
   bool fast_path = true;
+  /// Relative size (times the query's extent) below which the inclusion solver stops splitting a
+  /// box it cannot reject and reports a hit. Smaller: fewer false positives, more time.
+  double tolerance = 1e-6;
+  /// Boxes the inclusion solver may visit per query; past it the query is reported as a hit with
+  /// the earliest time still open (conservative, bounded time).
+  std::uint32_t max_boxes = 1u << 16;
+};
+
+/// Which part of the kernel decided a query.
+enum class CcdPath : std::uint8_t {
+  trivial,    ///< decided before any solver (e.g. thickness larger than the query)
+  np_culled,  ///< the Bernstein coefficients of the coplanarity cubic share a sign
+  fast_path,  ///< cubic root isolation, then inclusion restricted to the candidate times
+  inclusion,  ///< the inclusion solver over the whole of [0, 1]
 };
 
 struct CcdResult {
   bool hit = false;
-  /// Conservative time of impact in [0, 1]: never later than the true first contact (1 when no hit).
+  /// Conservative time of impact in [0, 1]: never later than the true first contact (1 when no
+  /// hit).
   double toi = 1.0;
+  /// Parameters of the hit box's centre (VF: barycentric weights of f1 and f2; EE: position along
+  /// edge a and edge b); meaningful only when hit.
+  double u = 0.0, v = 0.0;
+  CcdPath path = CcdPath::trivial;
+  /// Boxes visited by the inclusion solver (0 when it did not run).
+  std::uint32_t boxes = 0;
 };
 
 /// Zero false negatives: every query whose features come within `thickness` during the motion

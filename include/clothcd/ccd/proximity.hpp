@@ -1,0 +1,41 @@
+#pragma once
+/// @file
+/// Discrete proximity: closest points between a point and a triangle, and between two segments.
+/// Robust for degenerate input: a triangle collapsed to a segment or a point, zero-length edges
+/// and parallel or collinear edges all give a finite, correct answer (never NaN). Finite input is
+/// required (std::invalid_argument otherwise).
+
+#include <Eigen/Core>
+
+namespace clothcd {
+
+struct PointTriangleProximity {
+  double distance = 0;
+  /// Barycentric weights of the closest point on the triangle: w0 f0 + w1 f1 + w2 f2, all >= 0,
+  /// summing to 1.
+  Eigen::Vector3d weights = Eigen::Vector3d(1, 0, 0);
+  Eigen::Vector3d closest = Eigen::Vector3d::Zero();  ///< the closest point on the triangle
+};
+
+struct EdgeEdgeProximity {
+  double distance = 0;
+  /// Closest points ea0 + s (ea1 - ea0) and eb0 + t (eb1 - eb0), s and t in [0, 1].
+  double s = 0, t = 0;
+  Eigen::Vector3d closest_a = Eigen::Vector3d::Zero(), closest_b = Eigen::Vector3d::Zero();
+};
+
+[[nodiscard]] PointTriangleProximity point_triangle_proximity(const Eigen::Vector3d& p,
+                                                              const Eigen::Vector3d& f0,
+                                                              const Eigen::Vector3d& f1,
+                                                              const Eigen::Vector3d& f2);
+
+[[nodiscard]] EdgeEdgeProximity edge_edge_proximity(const Eigen::Vector3d& ea0,
+                                                    const Eigen::Vector3d& ea1,
+                                                    const Eigen::Vector3d& eb0,
+                                                    const Eigen::Vector3d& eb1);
+
+/// Closest point parameter of p on segment ab, in [0, 1] (0 for a zero-length segment).
+[[nodiscard]] double point_segment_parameter(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                             const Eigen::Vector3d& b);
+
+}  // namespace clothcd

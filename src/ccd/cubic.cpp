@@ -1,0 +1,114 @@
+#include "ccd/cubic.hpp"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+
+namespace clothcd::ccd_detail {
+
+namespace {
+
+constexpr double kUnitRoundoff = DBL_EPSILON / 2;
+
+struct V3 {
+  double x, y, z;
+};
+inline V3 sub(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return {a.x() - b.x(), a.y() - b.y(), a.z() - b.z()};
+}
+inline V3 cross(const V3& a, const V3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double dot(const V3& a, const V3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+inline double max_abs(const V3& a) {
+  return std::max({std::abs(a.x), std::abs(a.y), std::abs(a.z)});
+}
+
+}  // namespace
+
+BernsteinCubic coplanarity_cubic(Kind kind, const Motion& m) {
+  // Point indices of a, b, c, q in the motion's order.
+  const int ia = kind == Kind::vertex_face ? 1 : 0;
+  const int ib = kind == Kind::vertex_face ? 2 : 1;
+  const int ic = kind == Kind::vertex_face ? 3 : 2;
+  const int iq = kind == Kind::vertex_face ? 0 : 3;
+  const V3 e1_0 = sub(m.x0[ib], m.x0[ia]), e2_0 = sub(m.x0[ic], m.x0[ia]);
+  const V3 r0 = sub(m.x0[iq], m.x0[ia]);
+  const V3 e1_1 = sub(m.x1[ib], m.x1[ia]), e2_1 = sub(m.x1[ic], m.x1[ia]);
+  const V3 r1 = sub(m.x1[iq], m.x1[ia]);
+  const V3 n0 = cross(e1_0, e2_0), n1 = cross(e1_1, e2_1);
+  const V3 c01 = cross(e1_0, e2_1), c10 = cross(e1_1, e2_0);
+  // 2 nX = e1_0 x e2_1 + e1_1 x e2_0 (the better-conditioned form of the middle control vector).
+  const V3 nx2 = {c01.x + c10.x, c01.y + c10.y, c01.z + c10.z};
+  BernsteinCubic c;
+  c.k[0] = dot(n0, r0);
+  c.k[1] = (dot(nx2, r0) + dot(n0, r1)) / 3;
+  c.k[2] = (dot(nx2, r1) + dot(n1, r0)) / 3;
+  c.k[3] = dot(n1, r1);
+  // Forward error: with every computed difference at most A in magnitude, each coefficient is a
+  // sum of monomials of degree 3 whose absolute values add up to at most 6 A^3 (times 3 for the
+  // middle ones before the division), reached through at most ~12 roundings plus the relative
+  // error u of each difference factor: below 100 u A^3. 256 leaves margin for rounding A^3
+  // itself; the absolute term covers underflow (inputs are scaled so that |x| < 1).
+  const double a = std::max(
+      {max_abs(e1_0), max_abs(e2_0), max_abs(r0), max_abs(e1_1), max_abs(e2_1), max_abs(r1)});
+  c.eta = 256 * kUnitRoundoff * (a * a * a) + 1024 * std::numeric_limits<double>::denorm_min();
+  return c;
+}
+
+bool np_culls(const BernsteinCubic& c) {
+  const double e = c.eta;
+  return (c.k[0] > e && c.k[1] > e && c.k[2] > e && c.k[3] > e) ||
+         (c.k[0] < -e && c.k[1] < -e && c.k[2] < -e && c.k[3] < -e);
+}
+
+int candidate_times(const BernsteinCubic& c, int depth, double (*ranges)[2], int cap) {
+  // De Casteljau halving forms averages: each value stays within the convex hull of the
+  // coefficients (|.| <= K), each level adds at most one rounding of u K to three of them, and
+  // errors already present do not grow. depth <= 40 levels of 3 averages: 120 u K < 128 u K.
+  const double kmax =
+      std::max({std::abs(c.k[0]), std::abs(c.k[1]), std::abs(c.k[2]), std::abs(c.k[3])});
+  const double e = c.eta + 128 * kUnitRoundoff * kmax;
+  struct Item {
+    double b[4];
+    double lo, hi;
+    int level;
+  };
+  constexpr int kStack = 64;
+  Item stack[kStack];
+  int n = 0;
+  stack[n++] = Item{{c.k[0], c.k[1], c.k[2], c.k[3]}, 0.0, 1.0, 0};
+  int count = 0;
+  while (n > 0) {
+    const Item it = stack[--n];
+    const double* b = it.b;
+    if ((b[0] > e && b[1] > e && b[2] > e && b[3] > e) ||
+        (b[0] < -e && b[1] < -e && b[2] < -e && b[3] < -e)) {
+      continue;
+    }
+    if (it.level >= depth) {
+      if (count > 0 && ranges[count - 1][1] == it.lo) {
+        ranges[count - 1][1] = it.hi;  // contiguous with the previous range: extend it
+      } else {
+        if (count == cap) return -1;
+        ranges[count][0] = it.lo;
+        ranges[count][1] = it.hi;
+        ++count;
+      }
+      continue;
+    }
+    const double b01 = (b[0] + b[1]) * 0.5, b12 = (b[1] + b[2]) * 0.5, b23 = (b[2] + b[3]) * 0.5;
+    const double b012 = (b01 + b12) * 0.5, b123 = (b12 + b23) * 0.5;
+    const double mid_val = (b012 + b123) * 0.5;
+    const double mid = (it.lo + it.hi) * 0.5;
+    // Right half first so the left (earlier) one is processed first.
+    stack[n++] = Item{{mid_val, b123, b23, b[3]}, mid, it.hi, it.level + 1};
+    stack[n++] = Item{{b[0], b01, b012, mid_val}, it.lo, mid, it.level + 1};
+  }
+  return count;
+}
+
+}  // namespace clothcd::ccd_detail

@@ -1,0 +1,26 @@
+#pragma once
+// Internal: a query as four moving points, rescaled by a power of two so that the largest
+// coordinate lies in [0.5, 1). Scaling by 2^k is exact (bar subnormal underflow, which the error
+// bounds absorb), keeps every intermediate value far from overflow and underflow, and leaves the
+// answer (contact yes/no, time of impact) unchanged.
+
+#include <Eigen/Core>
+
+#include <array>
+
+namespace clothcd::ccd_detail {
+
+/// Point order. VF: v, f0, f1, f2. EE: ea0, ea1, eb0, eb1.
+enum class Kind { vertex_face, edge_edge };
+
+struct Motion {
+  std::array<Eigen::Vector3d, 4> x0, x1;  ///< positions at t = 0 and t = 1, scaled
+  Eigen::Vector3d max_abs;                ///< per axis, largest |coordinate| after scaling
+  double extent = 0;                      ///< largest coordinate range over the 8 points (scaled)
+  double scale = 1;                       ///< the power of two applied
+};
+
+/// Builds the scaled motion; throws std::invalid_argument on NaN/inf coordinates.
+Motion make_motion(const std::array<const Eigen::Vector3d*, 8>& points);
+
+}  // namespace clothcd::ccd_detail

@@ -1,0 +1,124 @@
+// The public CCD kernels: validation, rescaling, then the fast path (zero thickness) or the
+// inclusion solver. Soundness of the combination: a zero-thickness contact needs the four points
+// coplanar, i.e. a root of the exact coplanarity cubic; the fast path drops only time ranges on
+// which that cubic provably has no root and hands every other range to the inclusion solver.
+
+#include "clothcd/ccd/queries.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "ccd/cubic.hpp"
+#include "ccd/inclusion.hpp"
+#include "ccd/motion.hpp"
+
+namespace clothcd {
+
+namespace {
+
+using ccd_detail::Kind;
+using ccd_detail::Motion;
+
+// Candidate time ranges are isolated to 2^-kRootDepth before the inclusion solver takes over.
+constexpr int kRootDepth = 8;
+constexpr int kMaxRanges = 8;
+
+void check_options(const CcdOptions& opt) {
+  if (!(opt.thickness >= 0) || !std::isfinite(opt.thickness)) {
+    throw std::invalid_argument(
+        fmt::format("CCD thickness must be finite and >= 0, got {}", opt.thickness));
+  }
+  if (!(opt.tolerance > 0) || !std::isfinite(opt.tolerance)) {
+    throw std::invalid_argument(
+        fmt::format("CCD tolerance must be finite and > 0, got {}", opt.tolerance));
+  }
+}
+
+CcdResult from(const ccd_detail::InclusionOutcome& o, CcdPath path, std::uint32_t boxes) {
+  CcdResult r;
+  r.hit = o.hit;
+  r.toi = o.hit ? o.toi : 1.0;
+  r.u = o.u;
+  r.v = o.v;
+  r.path = path;
+  r.boxes = boxes;
+  return r;
+}
+
+CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
+              const CcdOptions& opt) {
+  check_options(opt);
+  const Motion m = ccd_detail::make_motion(points);
+  const double max_coord = m.max_abs.maxCoeff() / m.scale;
+  // Any two of the points are within 2 sqrt(3) max|x| < 4 max|x|: contact from the start. This
+  // also keeps the scaled thickness finite.
+  if (opt.thickness >= 4 * max_coord) {
+    CcdResult r;
+    r.hit = true;
+    r.toi = 0;
+    return r;
+  }
+  ccd_detail::InclusionParams p;
+  p.thickness = opt.thickness * m.scale;
+  p.tolerance = opt.tolerance * m.extent;
+  p.max_boxes = opt.max_boxes;
+
+  if (opt.fast_path && opt.thickness == 0) {
+    const ccd_detail::BernsteinCubic cubic = ccd_detail::coplanarity_cubic(kind, m);
+    if (ccd_detail::np_culls(cubic)) {
+      CcdResult r;
+      r.path = CcdPath::np_culled;
+      return r;
+    }
+    double ranges[kMaxRanges][2];
+    const int count = ccd_detail::candidate_times(cubic, kRootDepth, ranges, kMaxRanges);
+    if (count >= 0) {
+      std::uint32_t boxes = 0;
+      // In time order: the first range with a hit holds the earliest contact.
+      for (int i = 0; i < count; ++i) {
+        p.t_lo = ranges[i][0];
+        p.t_hi = ranges[i][1];
+        const auto o = ccd_detail::inclusion_solve(kind, m, p);
+        boxes += o.boxes;
+        if (o.hit) return from(o, CcdPath::fast_path, boxes);
+      }
+      CcdResult r;
+      r.path = CcdPath::fast_path;
+      r.boxes = boxes;
+      return r;
+    }
+  }
+  const auto o = ccd_detail::inclusion_solve(kind, m, p);
+  return from(o, CcdPath::inclusion, o.boxes);
+}
+
+std::array<const Eigen::Vector3d*, 8> points_of(const VertexFaceQuery& q) {
+  return {&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0, &q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1};
+}
+std::array<const Eigen::Vector3d*, 8> points_of(const EdgeEdgeQuery& q) {
+  return {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0, &q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1};
+}
+
+}  // namespace
+
+CcdResult vertex_face_ccd(const VertexFaceQuery& q, const CcdOptions& opt) {
+  return run(Kind::vertex_face, points_of(q), opt);
+}
+
+CcdResult edge_edge_ccd(const EdgeEdgeQuery& q, const CcdOptions& opt) {
+  return run(Kind::edge_edge, points_of(q), opt);
+}
+
+bool np_filter_culls(const VertexFaceQuery& q) {
+  return ccd_detail::np_culls(
+      ccd_detail::coplanarity_cubic(Kind::vertex_face, ccd_detail::make_motion(points_of(q))));
+}
+
+bool np_filter_culls(const EdgeEdgeQuery& q) {
+  return ccd_detail::np_culls(
+      ccd_detail::coplanarity_cubic(Kind::edge_edge, ccd_detail::make_motion(points_of(q))));
+}
+
+}  // namespace clothcd
