@@ -1,0 +1,47 @@
+#pragma once
+/// @file
+/// The plug-in point of the collision stage (docs/simulator.md section 3). The integrator calls
+/// one handler per substep in two phases: `prepare` at the start state (proximity query at x_n and
+/// b_n), then `respond` on the candidate velocities v* (repulsion, friction, CCD impulses, impact
+/// zones). The handler changes v* only; positions follow as x_{n+1} = x_n + h v*.
+
+#include <span>
+#include <vector>
+
+#include "clothcd/mesh/topology.hpp"
+#include "clothcd/sim/elements.hpp"
+
+namespace clothcd::sim {
+
+/// What a handler sees of one substep from t0 to t0 + h.
+struct SubstepContext {
+  double t0 = 0.0;
+  double h = 0.0;
+  std::span<const Vec3> x0;              ///< cloth at t0 (intersection-free by invariant)
+  std::span<const double> inverse_mass;  ///< 0 for pinned cloth vertices
+  const Topology* cloth = nullptr;
+  std::span<const Vec3> body_t0;  ///< body vertices at t0 and t0 + h (empty: no body)
+  std::span<const Vec3> body_t1;
+  const std::vector<Face>* body_faces = nullptr;
+};
+
+/// Per-substep figures a handler reports; summed per frame.
+struct CollisionStats {
+  long long proximity_pairs = 0;
+  long long ccd_hits = 0;
+  int ccd_passes = 0;
+  int zones = 0;
+  int largest_zone = 0;
+  double seconds = 0.0;
+};
+
+class CollisionHandler {
+ public:
+  virtual ~CollisionHandler() = default;
+  /// Before the dynamics solve.
+  virtual void prepare(const SubstepContext& ctx) = 0;
+  /// After it: adjust v* in place.
+  virtual CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v_star) = 0;
+};
+
+}  // namespace clothcd::sim

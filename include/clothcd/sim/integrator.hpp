@@ -1,0 +1,101 @@
+#pragma once
+/// @file
+/// Implicit Euler with one Newton step solved by filtered block-Jacobi PCG (Baraff & Witkin 1998;
+/// docs/simulator.md 2.1): (M + h(h+beta)H) dv = h(f_ext - grad U(x_n) - (h+beta) H v_n),
+/// v* = v_n + dv, x_{n+1} = x_n + h v*. Results are bitwise identical for any thread count.
+
+#include <memory>
+#include <vector>
+
+#include "clothcd/sim/cloth_model.hpp"
+#include "clothcd/sim/collision.hpp"
+
+namespace clothcd::sim {
+
+/// Positions, velocities, the last velocity change (PCG warm start) and the time: everything a
+/// run needs to continue bitwise identically.
+struct ClothState {
+  std::vector<Vec3> x;
+  std::vector<Vec3> v;
+  std::vector<Vec3> dv;
+  double time = 0.0;
+};
+
+/// Vertices held by a rigid handle: target(t) = center + v t + R(axis, omega t)(x0 - center),
+/// x0 being the vertices' positions when the group was added.
+struct PinGroup {
+  std::vector<int> vertices;
+  Vec3 center = Vec3::Zero();
+  Vec3 axis = Vec3::UnitY();
+  double angular_velocity = 0.0;  ///< rad/s about `axis`
+  Vec3 velocity = Vec3::Zero();   ///< m/s
+};
+
+struct SolverOptions {
+  Vec3 gravity{0.0, -9.81, 0.0};
+  int pcg_max_iterations = 200;
+  double pcg_tolerance = 1e-3;
+  /// A substep is halved (up to `max_halvings` times) when PCG ends above this relative residual
+  /// or the result is not finite.
+  double halve_residual = 1e-2;
+  int max_halvings = 3;
+};
+
+struct StepStats {
+  int solves = 0;          ///< PCG solves (more than one when halved)
+  int pcg_iterations = 0;  ///< summed over solves
+  int max_pcg_iterations = 0;
+  int halvings = 0;
+  bool converged = true;     ///< every solve reached pcg_tolerance
+  double max_stretch = 0.0;  ///< largest membrane stretch at the substeps' start states
+  CollisionStats collision;
+};
+
+/// Provides the body's vertices at a time (empty when there is no body).
+class BodyPositions {
+ public:
+  virtual ~BodyPositions() = default;
+  virtual void positions_at(double t, std::vector<Vec3>& out) = 0;
+  [[nodiscard]] virtual const std::vector<Face>& faces() const = 0;
+};
+
+class ClothSolver {
+ public:
+  ClothSolver(const ClothModel& model, const SolverOptions& options);
+  ~ClothSolver();
+  ClothSolver(const ClothSolver&) = delete;
+  ClothSolver& operator=(const ClothSolver&) = delete;
+
+  /// Adds a handle; its rest offsets are taken from `x`. Throws InputError on a bad vertex id.
+  void add_pins(const PinGroup& group, const std::vector<Vec3>& x);
+  /// Optional; not owned. Null disables collision handling.
+  void set_collision_handler(CollisionHandler* handler) { handler_ = handler; }
+  void set_body(BodyPositions* body) { body_ = body; }
+
+  /// The state at rest: initial positions, zero velocity, t = 0.
+  [[nodiscard]] ClothState initial_state() const;
+  /// Advances `state` by h (halving on failure as SolverOptions says).
+  StepStats step(ClothState& state, double h);
+
+  /// Potential energy (elastic + gravity) at x.
+  [[nodiscard]] double potential_energy(const std::vector<Vec3>& x) const;
+  /// Kinetic energy of v.
+  [[nodiscard]] double kinetic_energy(const std::vector<Vec3>& v) const;
+  /// Largest membrane stretch (sigma_max(F) - 1) at x.
+  [[nodiscard]] double max_stretch(const std::vector<Vec3>& x) const;
+
+  [[nodiscard]] const ClothModel& model() const { return model_; }
+
+ private:
+  struct Impl;
+  bool try_step(ClothState& state, double h, StepStats& stats, bool allow_fail);
+  void substep(ClothState& state, double h, int depth, StepStats& stats);
+
+  const ClothModel& model_;
+  SolverOptions options_;
+  std::unique_ptr<Impl> impl_;
+  CollisionHandler* handler_ = nullptr;
+  BodyPositions* body_ = nullptr;
+};
+
+}  // namespace clothcd::sim

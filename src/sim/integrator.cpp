@@ -1,0 +1,204 @@
+// Implicit Euler, one Newton step, filtered PCG; substep halving on failure.
+#include "clothcd/sim/integrator.hpp"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cmath>
+
+#include "clothcd/core/error.hpp"
+#include "pcg.hpp"
+#include "system.hpp"
+
+namespace clothcd::sim {
+namespace {
+constexpr int kGrain = 1024;
+
+template <typename F>
+void for_each_vertex(int n, const F& f) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, kGrain), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i < r.end(); ++i)
+      f(i);
+  });
+}
+
+struct PinnedVertex {
+  int vertex;
+  int group;
+  Vec3 offset;  // rest position relative to the group's center at t = 0
+};
+}  // namespace
+
+struct ClothSolver::Impl {
+  explicit Impl(const ClothModel& m) : assembler(m), h(assembler.make_matrix()) {}
+  SystemAssembler assembler;
+  BlockCsr h;
+  Vecs gradient, hv, b;
+  std::vector<PinGroup> groups;
+  std::vector<PinnedVertex> pinned;
+  VertexFilter filter;
+  std::vector<double> inverse_mass;
+  std::vector<Vec3> body_t0, body_t1;
+
+  Vec3 pin_target(const PinnedVertex& p, double t) const {
+    const PinGroup& g = groups[p.group];
+    const Eigen::AngleAxisd rot(g.angular_velocity * t, g.axis.normalized());
+    return g.center + g.velocity * t + rot * p.offset;
+  }
+};
+
+ClothSolver::ClothSolver(const ClothModel& model, const SolverOptions& options)
+    : model_(model), options_(options), impl_(std::make_unique<Impl>(model)) {
+  const int n = model.num_vertices();
+  impl_->filter.reset(n);
+  impl_->inverse_mass.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const double m = model.mass()[i];
+    // A vertex in no triangle has no mass: hold it where it is.
+    if (m <= 0.0) impl_->filter.kind[i] = VertexFilter::Pinned;
+    impl_->inverse_mass[i] = m > 0.0 ? 1.0 / m : 0.0;
+  }
+}
+
+ClothSolver::~ClothSolver() = default;
+
+void ClothSolver::add_pins(const PinGroup& group, const std::vector<Vec3>& x) {
+  const int n = model_.num_vertices();
+  const int gid = static_cast<int>(impl_->groups.size());
+  impl_->groups.push_back(group);
+  for (int v : group.vertices) {
+    if (v < 0 || v >= n) {
+      throw InputError(fmt::format("pinned vertex {} out of range 0..{}", v, n - 1));
+    }
+    impl_->pinned.push_back({v, gid, x[v] - group.center});
+    impl_->filter.kind[v] = VertexFilter::Pinned;
+    impl_->inverse_mass[v] = 0.0;
+  }
+}
+
+ClothState ClothSolver::initial_state() const {
+  ClothState s;
+  s.x = model_.initial_positions();
+  s.v.assign(s.x.size(), Vec3::Zero());
+  s.dv.assign(s.x.size(), Vec3::Zero());
+  return s;
+}
+
+bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool allow_fail) {
+  Impl& im = *impl_;
+  const int n = model_.num_vertices();
+  const double beta = model_.material().damping;
+  const auto& mass = model_.mass();
+
+  SubstepContext ctx;
+  if (handler_ != nullptr) {
+    ctx.t0 = state.time;
+    ctx.h = h;
+    ctx.x0 = state.x;
+    ctx.inverse_mass = im.inverse_mass;
+    ctx.cloth = &model_.topology();
+    if (body_ != nullptr) {
+      body_->positions_at(state.time, im.body_t0);
+      body_->positions_at(state.time + h, im.body_t1);
+      ctx.body_t0 = im.body_t0;
+      ctx.body_t1 = im.body_t1;
+      ctx.body_faces = &body_->faces();
+    }
+    const auto start = std::chrono::steady_clock::now();
+    handler_->prepare(ctx);
+    stats.collision.seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  const double stretch = im.assembler.assemble(state.x, im.h, im.gradient);
+  stats.max_stretch = std::max(stats.max_stretch, stretch);
+  im.hv.resize(n);
+  im.b.resize(n);
+  multiply(im.h, state.v, im.hv);
+  const Vec3 g = options_.gravity;
+  for_each_vertex(
+      n, [&](int i) { im.b[i] = h * (mass[i] * g - im.gradient[i] - (h + beta) * im.hv[i]); });
+  // Start: prescribed changes on pinned vertices, the previous change elsewhere (warm start).
+  Vecs dv(n);
+  for_each_vertex(n, [&](int i) { dv[i] = im.filter.apply(i, state.dv[i]); });
+  for (const PinnedVertex& p : im.pinned) {
+    dv[p.vertex] = (im.pin_target(p, state.time + h) - state.x[p.vertex]) / h - state.v[p.vertex];
+  }
+  const PcgOptions pcg{options_.pcg_max_iterations, options_.pcg_tolerance};
+  const PcgResult res = solve_pcg(im.h, h * (h + beta), mass, im.b, im.filter, pcg, dv);
+  ++stats.solves;
+  stats.pcg_iterations += res.iterations;
+  stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);
+  bool finite = std::isfinite(res.relative_residual);
+  for (int i = 0; i < n && finite; ++i)
+    finite = dv[i].allFinite();
+  if (!allow_fail && (!finite || res.relative_residual > options_.halve_residual)) return false;
+  if (!res.converged) stats.converged = false;
+
+  Vecs v_star(n);
+  for_each_vertex(n, [&](int i) { v_star[i] = state.v[i] + dv[i]; });
+  if (handler_ != nullptr) {
+    const auto start = std::chrono::steady_clock::now();
+    const CollisionStats cs = handler_->respond(ctx, v_star);
+    stats.collision.proximity_pairs += cs.proximity_pairs;
+    stats.collision.ccd_hits += cs.ccd_hits;
+    stats.collision.ccd_passes += cs.ccd_passes;
+    stats.collision.zones += cs.zones;
+    stats.collision.largest_zone = std::max(stats.collision.largest_zone, cs.largest_zone);
+    stats.collision.seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  for_each_vertex(n, [&](int i) {
+    state.x[i] += h * v_star[i];
+    state.v[i] = v_star[i];
+  });
+  state.dv = std::move(dv);
+  state.time += h;
+  return true;
+}
+
+void ClothSolver::substep(ClothState& state, double h, int depth, StepStats& stats) {
+  const bool last_chance = depth >= options_.max_halvings;
+  if (try_step(state, h, stats, last_chance)) return;
+  ++stats.halvings;
+  substep(state, 0.5 * h, depth + 1, stats);
+  substep(state, 0.5 * h, depth + 1, stats);
+}
+
+StepStats ClothSolver::step(ClothState& state, double h) {
+  StepStats stats;
+  substep(state, h, 0, stats);
+  return stats;
+}
+
+double ClothSolver::potential_energy(const std::vector<Vec3>& x) const {
+  double e = impl_->assembler.elastic_energy(x);
+  for (int i = 0; i < model_.num_vertices(); ++i)
+    e -= model_.mass()[i] * options_.gravity.dot(x[i]);
+  return e;
+}
+
+double ClothSolver::kinetic_energy(const std::vector<Vec3>& v) const {
+  double e = 0.0;
+  for (int i = 0; i < model_.num_vertices(); ++i)
+    e += 0.5 * model_.mass()[i] * v[i].squaredNorm();
+  return e;
+}
+
+double ClothSolver::max_stretch(const std::vector<Vec3>& x) const {
+  double s = 0.0;
+  const auto& faces = model_.topology().faces();
+  for (int f = 0; f < model_.topology().num_faces(); ++f) {
+    if (!model_.membrane_active()[f]) continue;
+    const Face& t = faces[f];
+    s = std::max(s, membrane_eval({x[t[0]], x[t[1]], x[t[2]]}, model_.membrane_rest()[f],
+                                  model_.moduli(), true)
+                        .max_stretch);
+  }
+  return s;
+}
+
+}  // namespace clothcd::sim

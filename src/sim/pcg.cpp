@@ -1,0 +1,93 @@
+// Filtered block-Jacobi PCG.
+#include "pcg.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace clothcd::sim {
+namespace {
+constexpr int kGrain = 1024;
+
+template <typename F>
+void for_each_vertex(int n, const F& f) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, kGrain), [&](const tbb::blocked_range<int>& r) {
+    for (int i = r.begin(); i < r.end(); ++i)
+      f(i);
+  });
+}
+
+double dot(const Vecs& a, const Vecs& b) {
+  return deterministic_sum(static_cast<int>(a.size()), [&](int lo, int hi) {
+    double s = 0.0;
+    for (int i = lo; i < hi; ++i)
+      s += a[i].dot(b[i]);
+    return s;
+  });
+}
+
+/// y = (M + c H) x
+void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x,
+                  Vecs& y) {
+  multiply(h, x, y);
+  for_each_vertex(static_cast<int>(x.size()), [&](int i) { y[i] = mass[i] * x[i] + c * y[i]; });
+}
+}  // namespace
+
+PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
+                    std::span<const Vec3> b, const VertexFilter& filter, const PcgOptions& options,
+                    Vecs& dv) {
+  const int n = static_cast<int>(b.size());
+  std::vector<Mat3> pinv(n);
+  for_each_vertex(n, [&](int i) {
+    const Mat3 d = mass[i] * Mat3::Identity() + c * h.values[h.diag[i]];
+    pinv[i] = d.inverse();
+  });
+  Vecs r(n), s(n), p(n), q(n), fb(n);
+  apply_system(h, c, mass, dv, q);
+  for_each_vertex(n, [&](int i) {
+    r[i] = filter.apply(i, b[i] - q[i]);
+    fb[i] = filter.apply(i, b[i]);
+  });
+  for_each_vertex(n, [&](int i) { s[i] = pinv[i] * fb[i]; });
+  const double delta0 = dot(fb, s);
+  for_each_vertex(n, [&](int i) { p[i] = filter.apply(i, pinv[i] * r[i]); });
+  double delta = dot(r, p);
+  PcgResult result;
+  const double tol2 = options.tolerance * options.tolerance;
+  auto rel = [&](double d) { return delta0 > 0.0 ? std::sqrt(std::max(d, 0.0) / delta0) : 0.0; };
+  if (delta0 <= 0.0 || delta <= tol2 * delta0) {
+    result.converged = std::isfinite(delta);
+    result.relative_residual = rel(delta);
+    return result;
+  }
+  for (int it = 0; it < options.max_iterations; ++it) {
+    apply_system(h, c, mass, p, q);
+    for_each_vertex(n, [&](int i) { q[i] = filter.apply(i, q[i]); });
+    const double pq = dot(p, q);
+    if (!(pq > 0.0)) break;  // breakdown: PSD matrix and nonzero p make this impossible in theory
+    const double alpha = delta / pq;
+    for_each_vertex(n, [&](int i) {
+      dv[i] += alpha * p[i];
+      r[i] -= alpha * q[i];
+      s[i] = filter.apply(i, pinv[i] * r[i]);
+    });
+    const double delta_new = dot(r, s);
+    result.iterations = it + 1;
+    if (!std::isfinite(delta_new)) {
+      delta = delta_new;
+      break;
+    }
+    const double beta = delta_new / delta;
+    delta = delta_new;
+    if (delta <= tol2 * delta0) break;
+    for_each_vertex(n, [&](int i) { p[i] = s[i] + beta * p[i]; });
+  }
+  result.relative_residual = rel(delta);
+  result.converged = std::isfinite(delta) && delta <= tol2 * delta0;
+  return result;
+}
+
+}  // namespace clothcd::sim

@@ -1,0 +1,63 @@
+#pragma once
+// The implicit system's sparse matrix: 3x3 blocks in a CSR pattern fixed once from the cloth's
+// elements, filled by a gather (every slot sums its contributions in a fixed order), so assembly
+// is parallel and bitwise independent of the thread count.
+
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "clothcd/sim/cloth_model.hpp"
+
+namespace clothcd::sim {
+
+using Vecs = std::vector<Vec3>;
+
+/// Symmetric block matrix in CSR form (both triangles stored).
+struct BlockCsr {
+  std::vector<int> row_start;  ///< size n + 1
+  std::vector<int> cols;       ///< block column of each slot, ascending per row
+  std::vector<int> diag;       ///< slot of (i, i)
+  std::vector<Mat3> values;
+
+  [[nodiscard]] int rows() const { return static_cast<int>(row_start.size()) - 1; }
+  /// Slot of block (i, j); the block must be in the pattern.
+  [[nodiscard]] int slot(int i, int j) const;
+};
+
+/// Assembles the membrane Hessian and gradient plus the constant bending and stitch terms.
+class SystemAssembler {
+ public:
+  explicit SystemAssembler(const ClothModel& model);
+
+  /// H = membrane (PSD-projected) + constant part, and the full gradient of the elastic energy at
+  /// x. Returns the largest membrane stretch at x.
+  double assemble(std::span<const Vec3> x, BlockCsr& h, Vecs& gradient);
+
+  /// An empty matrix with the pattern (values zero).
+  [[nodiscard]] BlockCsr make_matrix() const;
+
+  /// Total elastic energy at x (membrane + bending + stitches).
+  [[nodiscard]] double elastic_energy(std::span<const Vec3> x) const;
+
+ private:
+  const ClothModel& model_;
+  BlockCsr pattern_;
+  std::vector<int> active_faces_;
+  std::vector<Mat3> constant_;       // bending + stitch Hessian, per slot
+  std::vector<int> slot_src_start_;  // per slot: range into slot_src_
+  std::vector<int> slot_src_;        // index into face Hessian buffer (face * 9 + i * 3 + j)
+  std::vector<int> vert_src_start_;  // per vertex: range into vert_src_
+  std::vector<int> vert_src_;        // index into face gradient buffer (face * 3 + i)
+  std::vector<Mat3> face_hess_;
+  std::vector<Vec3> face_grad_;
+  std::vector<double> face_stretch_;
+};
+
+/// y = A x for a block matrix (parallel over rows).
+void multiply(const BlockCsr& a, std::span<const Vec3> x, std::span<Vec3> y);
+
+/// Sum over i of f(i) with a split tree fixed by n alone: bitwise equal for any thread count.
+double deterministic_sum(int n, const std::function<double(int, int)>& range_sum);
+
+}  // namespace clothcd::sim
