@@ -1,0 +1,115 @@
+#pragma once
+/// @file
+/// A binary BVH over a mesh's triangles (one triangle per leaf) with a normal cone hierarchy.
+/// Built once from a reference shape; refit every step with swept boxes and normal cones.
+/// Layout: a flat node array in breadth-first order (children adjacent, after their parent, each
+/// depth contiguous so a refit runs level by level in parallel), a primitive permutation in which
+/// every node covers one contiguous range, and the cones in an array beside the nodes.
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "clothcd/geometry/cone.hpp"
+#include "clothcd/mesh/topology.hpp"
+
+namespace clothcd {
+
+/// How the tree is split at build time.
+enum class BvhBuild {
+  Spatial,  ///< median split of triangle centroids along the longest axis
+  Patch,    ///< every node an edge-connected patch where the mesh allows it
+};
+
+/// How node normal cones are computed at refit (docs/algorithms.md sections 3, 4, 8).
+enum class ConePolicy {
+  Provot,    ///< C_Tang leaves, M_Provot merges (the paper's PROVOT)
+  Proposed,  ///< C_Proposed leaves, M_Proposed merges (the paper's PROPOSED)
+  Exact,     ///< exact leaf caps, M_Proposed merges (ours)
+  Optimal,   ///< optimal cone of every descendant leaf's control directions (slow reference)
+};
+
+/// One node: 64 bytes. Leaves hold exactly one triangle, prim_ids()[first].
+struct BvhNode {
+  std::array<double, 3> lo{};
+  std::array<double, 3> hi{};
+  std::int32_t left = -1;  ///< index of the first child (the second is left + 1); -1 for a leaf
+  std::int32_t first = 0;  ///< first position of the node's triangles in prim_ids()
+  std::int32_t count = 0;  ///< number of triangles below the node
+  std::uint32_t flags = 0;
+
+  static constexpr std::uint32_t kConnected = 1;  ///< triangles are edge-connected
+  static constexpr std::uint32_t kDisk = 2;       ///< a consistently oriented topological disk
+
+  [[nodiscard]] bool is_leaf() const { return left < 0; }
+  [[nodiscard]] bool connected() const { return (flags & kConnected) != 0; }
+  [[nodiscard]] bool disk() const { return (flags & kDisk) != 0; }
+};
+static_assert(sizeof(BvhNode) == 64, "BvhNode must stay one cache line");
+
+/// Box overlap of two nodes (closed boxes).
+[[nodiscard]] inline bool overlap(const BvhNode& a, const BvhNode& b) {
+  return a.lo[0] <= b.hi[0] && b.lo[0] <= a.hi[0] && a.lo[1] <= b.hi[1] && b.lo[1] <= a.hi[1] &&
+         a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
+}
+
+/// Options of a refit.
+struct RefitOptions {
+  double thickness = 0.0;  ///< boxes grow by thickness / 2 on every side (rounded outwards)
+  bool cones = true;       ///< compute the normal cones (box-only traversal skips them)
+  ConePolicy policy = ConePolicy::Proposed;
+};
+
+class Bvh {
+ public:
+  Bvh() = default;
+  /// Builds over all faces of `topology` using the reference positions (n x 3) for the splits.
+  /// The topology must outlive the Bvh.
+  Bvh(const Topology& topology, std::span<const Eigen::Vector3d> reference, BvhBuild build);
+
+  [[nodiscard]] const std::vector<BvhNode>& nodes() const { return nodes_; }
+  [[nodiscard]] const std::vector<int>& prim_ids() const { return prim_ids_; }
+  /// Node index of the leaf that holds face f.
+  [[nodiscard]] int leaf_of_face(int f) const { return leaf_of_face_[f]; }
+  /// Node ranges of each depth: level d is [level_offsets()[d], level_offsets()[d + 1]).
+  [[nodiscard]] const std::vector<int>& level_offsets() const { return level_offsets_; }
+  [[nodiscard]] int depth() const { return static_cast<int>(level_offsets_.size()) - 1; }
+  /// The oriented boundary loop (vertex ids) of a disk node; empty for other nodes.
+  [[nodiscard]] std::span<const int> contour(int node) const;
+  /// Normal cones of the last refit with cones, one per node.
+  [[nodiscard]] const std::vector<NormalCone>& cones() const { return cones_; }
+  [[nodiscard]] const Topology& topology() const { return *topology_; }
+
+  /// Internal nodes whose triangles are edge-connected / are disks, and all internal nodes.
+  [[nodiscard]] int num_internal() const;
+  [[nodiscard]] int num_connected_internal() const;
+  [[nodiscard]] int num_disk_internal() const;
+
+  /// Swept boxes of every triangle over the linear motion t0 -> t1 and, optionally, CCD cones.
+  void refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+             const RefitOptions& options);
+  /// Static boxes and skinny (DCD) cones at the positions v.
+  void refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options);
+
+ private:
+  template <class LeafFn>
+  void refit_levels(const RefitOptions& options, LeafFn&& leaf);
+  void compute_flags();
+
+  const Topology* topology_ = nullptr;
+  std::vector<BvhNode> nodes_;
+  std::vector<int> prim_ids_;
+  std::vector<int> leaf_of_face_;
+  std::vector<int> level_offsets_;
+  std::vector<int> contour_offsets_;  // CSR per node
+  std::vector<int> contour_vertices_;
+  std::vector<NormalCone> cones_;
+  // Unit Bernstein control directions of each leaf, by prim position (Optimal policy only).
+  std::vector<Eigen::Vector3d> control_dirs_;
+  std::vector<std::uint8_t> degenerate_;
+};
+
+}  // namespace clothcd

@@ -1,0 +1,90 @@
+#pragma once
+/// @file
+/// The detector a simulator calls every step: continuous self-collision detection of one mesh
+/// (BVH with a normal cone hierarchy, culling modes, R-triangles and orphan sets, NP filter,
+/// CCD kernels), and inter-object detection between two meshes (cloth against body).
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "clothcd/detect/types.hpp"
+
+namespace clothcd {
+
+/// n x 3 vertex positions, one row per vertex.
+using Positions = Eigen::MatrixXd;
+
+/// Proximity pairs: features closer than h at one instant (no cone culling: algorithms.md 1.1).
+struct ProximityResult {
+  struct VertexFace {
+    int vertex, face;
+    double distance;
+  };
+  struct EdgeEdge {
+    int edge_a, edge_b;
+    double distance;
+  };
+  std::vector<VertexFace> vf;  ///< sorted by (vertex, face)
+  std::vector<EdgeEdge> ee;    ///< sorted by (edge_a, edge_b)
+};
+
+class SelfDetector {
+ public:
+  /// Builds the topology, the orphan sets and the BVH (split on `reference`, e.g. the rest shape
+  /// or the first frame). Throws InputError on bad faces or a reference of the wrong size.
+  SelfDetector(std::vector<Face> faces, int num_vertices, const Positions& reference,
+               const DetectOptions& options = {});
+  ~SelfDetector();
+  SelfDetector(SelfDetector&&) noexcept;
+  SelfDetector& operator=(SelfDetector&&) noexcept;
+
+  /// All VF and EE pairs that touch during the linear motion v_t0 -> v_t1 (CCD). Results are
+  /// sorted and do not depend on the number of threads.
+  [[nodiscard]] DetectResult detect(const Positions& v_t0, const Positions& v_t1);
+
+  /// VF and EE pairs closer than h at positions v (box culling only).
+  [[nodiscard]] ProximityResult proximity(const Positions& v, double h);
+
+  /// Restricts detection to pairs in which at least one feature belongs to an active triangle.
+  void set_active_faces(std::span<const int> faces);
+  void clear_active_faces();
+
+  [[nodiscard]] const DetectOptions& options() const;
+  void set_options(const DetectOptions& options);  ///< the BVH build stays as constructed
+  [[nodiscard]] const Topology& topology() const;
+  [[nodiscard]] const Bvh& bvh() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Collisions between two meshes A (e.g. a garment) and B (e.g. a body); no self-collisions.
+struct PairDetectResult {
+  std::vector<VertexFaceCollision> vf_a_on_b;  ///< vertex of A, face of B
+  std::vector<VertexFaceCollision> vf_b_on_a;  ///< vertex of B, face of A
+  std::vector<EdgeEdgeCollision> ee;           ///< edge_a of A, edge_b of B
+  DetectStats stats;
+};
+
+class PairDetector {
+ public:
+  PairDetector(std::vector<Face> faces_a, int num_vertices_a, const Positions& reference_a,
+               std::vector<Face> faces_b, int num_vertices_b, const Positions& reference_b,
+               const DetectOptions& options = {});
+  ~PairDetector();
+  PairDetector(PairDetector&&) noexcept;
+  PairDetector& operator=(PairDetector&&) noexcept;
+
+  [[nodiscard]] PairDetectResult detect(const Positions& a_t0, const Positions& a_t1,
+                                        const Positions& b_t0, const Positions& b_t1);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clothcd

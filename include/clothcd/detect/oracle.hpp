@@ -1,0 +1,23 @@
+#pragma once
+/// @file
+/// Brute-force reference for the detector: every VF and EE feature pair of the mesh, each put
+/// through the same feature box test, NP filter and kernel as the detector. Quadratic: tests only.
+
+#include "clothcd/detect/detector.hpp"
+
+namespace clothcd {
+
+/// All pairs of features that touch during v_t0 -> v_t1; `active` (optional, per face) restricts
+/// to pairs with at least one feature on an active face. Stats hold the test counts only.
+[[nodiscard]] DetectResult brute_force_detect(const Topology& topology, const Positions& v_t0,
+                                              const Positions& v_t1,
+                                              const DetectOptions& options = {},
+                                              std::span<const std::uint8_t> active = {});
+
+/// Brute-force two-mesh reference of PairDetector.
+[[nodiscard]] PairDetectResult brute_force_detect_pair(const Topology& a, const Positions& a_t0,
+                                                       const Positions& a_t1, const Topology& b,
+                                                       const Positions& b_t0, const Positions& b_t1,
+                                                       const DetectOptions& options = {});
+
+}  // namespace clothcd

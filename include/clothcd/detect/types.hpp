@@ -1,0 +1,95 @@
+#pragma once
+/// @file
+/// Options, collisions and statistics of the collision detection pipeline.
+
+#include <cstdint>
+#include <vector>
+
+#include "clothcd/bvh/bvh.hpp"
+#include "clothcd/mesh/topology.hpp"
+
+namespace clothcd {
+
+/// When the self traversal may skip a node's self-collision test (docs/detect.md).
+enum class Culling {
+  None,   ///< boxes only
+  Cone,   ///< the paper's literal rule: cone below pi/2 (unsound)
+  Gated,  ///< cone below pi/2 on edge-connected nodes only (still unsound: the winding strip)
+  Sound,  ///< gated, on disk nodes, plus the contour test: finds exactly what None finds
+};
+
+struct DetectOptions {
+  ConePolicy policy = ConePolicy::Proposed;
+  Culling culling = Culling::None;
+  BvhBuild build = BvhBuild::Spatial;
+  /// Contact distance of the CCD kernels; boxes grow with it. Cone culling needs zero thickness
+  /// to be sound, so Culling::Sound culls nothing when thickness > 0.
+  double thickness = 0.0;
+  /// Deforming NP filter before the kernels (applied at zero thickness only).
+  bool np_filter = true;
+  /// CcdOptions::fast_path of the kernels.
+  bool fast_path = true;
+  /// Also run the unculled traversal and report what the culled one missed.
+  bool verify = false;
+};
+
+/// Vertex `vertex` hits face `face` (vertex ids `face_vertices`) at time `toi` in [0, 1].
+struct VertexFaceCollision {
+  int vertex = -1;
+  int face = -1;
+  Face face_vertices{};
+  double toi = 1.0;
+  friend bool operator==(const VertexFaceCollision&, const VertexFaceCollision&) = default;
+};
+
+/// Edge `edge_a` < `edge_b` (Topology edge ids) touch at time `toi`.
+struct EdgeEdgeCollision {
+  int edge_a = -1;
+  int edge_b = -1;
+  Edge edge_a_vertices{};
+  Edge edge_b_vertices{};
+  double toi = 1.0;
+  friend bool operator==(const EdgeEdgeCollision&, const EdgeEdgeCollision&) = default;
+};
+
+/// Counters and times of one detection call (times in seconds).
+struct DetectStats {
+  std::uint64_t box_tests = 0;      ///< node-pair box tests of the traversal
+  std::uint64_t nodes_culled = 0;   ///< self tests skipped by the culling rule
+  std::uint64_t cone_tests = 0;     ///< internal self tests that evaluated the rule
+  std::uint64_t contour_tests = 0;  ///< contour tests run (Sound)
+  std::uint64_t contour_fails = 0;  ///< ... of which failed, so the cone could not cull
+  int internal_nodes = 0;
+  int connected_internal_nodes = 0;  ///< internal nodes whose triangles are edge-connected
+  int disk_internal_nodes = 0;
+  std::uint64_t adjacent_pairs = 0;  ///< overlapping vertex-sharing leaf pairs (left to orphans)
+  std::uint64_t triangle_pairs = 0;  ///< non-adjacent triangle pairs reaching the narrow phase
+  std::uint64_t vf_tests = 0;        ///< VF feature pairs past the feature box test (incl. orphans)
+  std::uint64_t ee_tests = 0;
+  std::uint64_t vf_np_culled = 0;  ///< ... of which the NP filter culled
+  std::uint64_t ee_np_culled = 0;
+  std::uint64_t vf_orphans = 0;  ///< orphan feature pairs checked (all of them, every step)
+  std::uint64_t ee_orphans = 0;
+  std::uint64_t vf_collisions = 0;
+  std::uint64_t ee_collisions = 0;
+  double time_refit = 0;  ///< boxes and cones
+  double time_traverse = 0;
+  double time_narrow = 0;  ///< feature tests of the triangle pairs and the orphans
+
+  [[nodiscard]] double connected_share() const {
+    return internal_nodes > 0 ? double(connected_internal_nodes) / internal_nodes : 1.0;
+  }
+};
+
+struct DetectResult {
+  std::vector<VertexFaceCollision> vf;  ///< sorted by (vertex, face)
+  std::vector<EdgeEdgeCollision> ee;    ///< sorted by (edge_a, edge_b)
+  DetectStats stats;
+  /// With DetectOptions::verify: collisions the unculled traversal finds and this one missed.
+  bool verified = false;
+  std::vector<VertexFaceCollision> missed_vf;
+  std::vector<EdgeEdgeCollision> missed_ee;
+  std::uint64_t unculled_triangle_pairs = 0;  ///< triangle pairs of the unculled traversal
+};
+
+}  // namespace clothcd

@@ -1,0 +1,152 @@
+// Refit: swept boxes and normal cones, level by level from the deepest, each level in parallel.
+
+#include <tbb/parallel_for.h>
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "clothcd/bvh/bvh.hpp"
+
+namespace clothcd {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+NormalCone full_cone() {
+  return NormalCone{Eigen::Vector3d::UnitZ(), std::numbers::pi};
+}
+
+LeafConePolicy leaf_policy(ConePolicy p) {
+  switch (p) {
+    case ConePolicy::Provot:
+      return LeafConePolicy::Tang;
+    case ConePolicy::Proposed:
+      return LeafConePolicy::Proposed;
+    case ConePolicy::Exact:
+    case ConePolicy::Optimal:
+      return LeafConePolicy::Exact;
+  }
+  return LeafConePolicy::Exact;
+}
+
+void inflate(BvhNode& n, double margin) {
+  if (margin <= 0) return;
+  for (int k = 0; k < 3; ++k) {
+    n.lo[k] = std::nextafter(n.lo[k] - margin, -kInf);
+    n.hi[k] = std::nextafter(n.hi[k] + margin, kInf);
+  }
+}
+
+void set_box(BvhNode& n, std::initializer_list<const Eigen::Vector3d*> pts) {
+  for (int k = 0; k < 3; ++k) {
+    n.lo[k] = kInf;
+    n.hi[k] = -kInf;
+  }
+  for (const Eigen::Vector3d* p : pts) {
+    for (int k = 0; k < 3; ++k) {
+      n.lo[k] = std::min(n.lo[k], (*p)[k]);
+      n.hi[k] = std::max(n.hi[k], (*p)[k]);
+    }
+  }
+}
+
+}  // namespace
+
+template <class LeafFn>
+void Bvh::refit_levels(const RefitOptions& options, LeafFn&& leaf) {
+  const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
+  if (optimal) {
+    control_dirs_.resize(3 * prim_ids_.size());
+    degenerate_.resize(prim_ids_.size());
+  }
+  for (int d = depth() - 1; d >= 0; --d) {
+    tbb::parallel_for(tbb::blocked_range<int>(level_offsets_[d], level_offsets_[d + 1], 256),
+                      [&](const tbb::blocked_range<int>& range) {
+                        for (int i = range.begin(); i != range.end(); ++i) {
+                          BvhNode& n = nodes_[i];
+                          if (n.is_leaf()) {
+                            leaf(n, i);
+                            continue;
+                          }
+                          const BvhNode& l = nodes_[n.left];
+                          const BvhNode& r = nodes_[n.left + 1];
+                          for (int k = 0; k < 3; ++k) {
+                            n.lo[k] = std::min(l.lo[k], r.lo[k]);
+                            n.hi[k] = std::max(l.hi[k], r.hi[k]);
+                          }
+                          if (!options.cones) continue;
+                          const NormalCone& cl = cones_[n.left];
+                          const NormalCone& cr = cones_[n.left + 1];
+                          // Saturation is monotone up the tree: an enclosing cone is at least as
+                          // wide.
+                          if (cl.saturated() || cr.saturated()) {
+                            cones_[i] = full_cone();
+                          } else if (options.policy == ConePolicy::Provot) {
+                            cones_[i] = merge_provot(cl, cr);
+                          } else if (!optimal) {
+                            cones_[i] = merge_tight(cl, cr);
+                          } else {
+                            cones_[i] = optimal_cone(std::span<const Eigen::Vector3d>(
+                                control_dirs_.data() + 3 * static_cast<std::size_t>(n.first),
+                                3 * static_cast<std::size_t>(n.count)));
+                          }
+                        }
+                      });
+  }
+}
+
+void Bvh::refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                const RefitOptions& options) {
+  const double margin = 0.5 * options.thickness;
+  const LeafConePolicy lp = leaf_policy(options.policy);
+  const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
+  const auto& faces = topology_->faces();
+  refit_levels(options, [&](BvhNode& n, int i) {
+    const Face& t = faces[prim_ids_[n.first]];
+    const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
+    const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
+    set_box(n, {&a0, &b0, &c0, &a1, &b1, &c1});
+    inflate(n, margin);
+    if (!options.cones) return;
+    cones_[i] = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, lp);
+    if (optimal) {
+      // Bernstein control vectors of the quadratic normal n(t) (algorithms.md 1.3).
+      const Eigen::Vector3d n0 = (b0 - a0).cross(c0 - a0);
+      const Eigen::Vector3d n1 = (b1 - a1).cross(c1 - a1);
+      const Eigen::Vector3d nx = 0.5 * ((b0 - a0).cross(c1 - a1) + (b1 - a1).cross(c0 - a0));
+      Eigen::Vector3d* d = control_dirs_.data() + 3 * static_cast<std::size_t>(n.first);
+      const bool bad = !(n0.norm() > 0) || !(nx.norm() > 0) || !(n1.norm() > 0);
+      degenerate_[n.first] = bad ? 1 : 0;
+      d[0] = bad ? Eigen::Vector3d::UnitZ() : n0.normalized();
+      d[1] = bad ? Eigen::Vector3d::UnitZ() : nx.normalized();
+      d[2] = bad ? Eigen::Vector3d::UnitZ() : n1.normalized();
+      if (bad) cones_[i] = full_cone();
+    }
+  });
+}
+
+void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options) {
+  const double margin = 0.5 * options.thickness;
+  const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
+  const auto& faces = topology_->faces();
+  refit_levels(options, [&](BvhNode& n, int i) {
+    const Face& t = faces[prim_ids_[n.first]];
+    const Eigen::Vector3d &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
+    set_box(n, {&a, &b, &c});
+    inflate(n, margin);
+    if (!options.cones) return;
+    cones_[i] = dcd_leaf_cone(a, b, c);
+    if (optimal) {
+      const Eigen::Vector3d nrm = (b - a).cross(c - a);
+      const bool bad = !(nrm.norm() > 0);
+      Eigen::Vector3d* d = control_dirs_.data() + 3 * static_cast<std::size_t>(n.first);
+      degenerate_[n.first] = bad ? 1 : 0;
+      d[0] = d[1] = d[2] = bad ? Eigen::Vector3d::UnitZ() : nrm.normalized();
+      if (bad) cones_[i] = full_cone();
+    }
+  });
+}
+
+}  // namespace clothcd

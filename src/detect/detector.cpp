@@ -1,0 +1,383 @@
+// The self-collision detector: refit, culled self traversal, narrow phase over representative
+// triangle pairs and orphans.
+
+#include "clothcd/detect/detector.hpp"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+#include "clothcd/ccd/proximity.hpp"
+#include "contour.hpp"
+#include "narrow.hpp"
+#include "orphans.hpp"
+#include "positions.hpp"
+#include "traversal.hpp"
+
+namespace clothcd {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// Cones are compared against pi/2 with a small margin for the rounding of the merges.
+constexpr double kConeMargin = 1e-9;
+
+struct PairBuffer {
+  std::vector<std::pair<int, int>> pairs;
+  std::uint64_t adjacent = 0;
+};
+
+struct NarrowBuffer {
+  detail::FeatureCounters c;
+  std::vector<VertexFaceCollision> vf;
+  std::vector<EdgeEdgeCollision> ee;
+};
+
+}  // namespace
+
+struct SelfDetector::Impl {
+  Topology topo;
+  DetectOptions opt;
+  Bvh bvh;
+  detail::Orphans orphans;
+  std::vector<Eigen::Vector3d> v0, v1;
+  // Active restriction: features on active faces, and the nodes holding a face that touches one.
+  bool restricted = false;
+  std::vector<std::uint8_t> face_active, vertex_active, edge_active, node_active;
+
+  Impl(std::vector<Face> faces, int nv, const Positions& ref, const DetectOptions& o)
+      : topo(std::move(faces), nv), opt(o) {
+    detail::to_points(ref, nv, "reference shape", v0);
+    bvh = Bvh(topo, v0, o.build);
+    orphans = detail::find_orphans(topo);
+  }
+
+  [[nodiscard]] bool cones_used(Culling mode) const {
+    return mode != Culling::None && !(mode == Culling::Sound && opt.thickness > 0);
+  }
+
+  [[nodiscard]] bool vf_in_scope(int v, int f) const {
+    return !restricted || vertex_active[v] != 0 || face_active[f] != 0;
+  }
+  [[nodiscard]] bool ee_in_scope(int ea, int eb) const {
+    return !restricted || edge_active[ea] != 0 || edge_active[eb] != 0;
+  }
+
+  // Overlapping non-adjacent leaf pairs of the culled self traversal.
+  std::vector<std::pair<int, int>> traverse(Culling mode, DetectStats& st) {
+    const auto& nodes = bvh.nodes();
+    const auto& prims = bvh.prim_ids();
+    const auto& cones = bvh.cones();
+    const bool use_cones = cones_used(mode);
+    auto cull = [&](int i, detail::TraversalCounters& c) {
+      if (!use_cones) return false;
+      const BvhNode& n = nodes[i];
+      if (mode == Culling::Gated && !n.connected()) return false;
+      if (mode == Culling::Sound && !n.disk()) return false;
+      ++c.cone_tests;
+      const NormalCone& k = cones[i];
+      if (!(k.half_angle < std::numbers::pi / 2 - kConeMargin)) return false;
+      if (mode != Culling::Sound) return true;
+      ++c.contour_tests;
+      const bool ok = detail::contour_star_shaped(bvh.contour(i), v0, v1, k.axis);
+      if (!ok) ++c.contour_fails;
+      return ok;
+    };
+    const auto& faces = topo.faces();
+    auto leaf = [&](int a, int b, PairBuffer& out) {
+      const int fa = prims[nodes[a].first], fb = prims[nodes[b].first];
+      if (detail::share_vertex(faces[fa], faces[fb])) {
+        ++out.adjacent;
+        return;
+      }
+      out.pairs.emplace_back(fa, fb);
+    };
+    std::span<const std::uint8_t> act;
+    if (restricted) act = node_active;
+    auto tr = detail::make_traversal(nodes, nodes, act, act, cull, leaf);
+    tbb::enumerable_thread_specific<PairBuffer> locals;
+    std::vector<std::pair<int, int>> pairs;
+    if (nodes.empty()) return pairs;
+    const detail::TraversalCounters c = detail::run_parallel(tr, {0, 0, true}, locals);
+    st.box_tests = c.box_tests;
+    st.nodes_culled = c.culled;
+    st.cone_tests = c.cone_tests;
+    st.contour_tests = c.contour_tests;
+    st.contour_fails = c.contour_fails;
+    std::size_t total = 0;
+    for (const auto& l : locals)
+      total += l.pairs.size();
+    pairs.reserve(total);
+    for (const auto& l : locals) {
+      pairs.insert(pairs.end(), l.pairs.begin(), l.pairs.end());
+      st.adjacent_pairs += l.adjacent;
+    }
+    return pairs;
+  }
+
+  void narrow(const std::vector<std::pair<int, int>>& pairs, DetectResult& res) {
+    detail::FeatureContext ctx;
+    ctx.topo = &topo;
+    ctx.v0 = v0;
+    ctx.v1 = v1;
+    ctx.margin = 0.5 * opt.thickness;
+    ctx.np_filter = opt.np_filter;
+    ctx.ccd = CcdOptions{opt.thickness, opt.fast_path};
+    tbb::enumerable_thread_specific<NarrowBuffer> locals;
+    auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
+    auto kee = [&](int a, int b, NarrowBuffer& out) { ctx.kernel_ee(a, b, out.c, out.ee); };
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        NarrowBuffer& out = locals.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          triangle_pair(ctx, pairs[i].first, pairs[i].second, out, kvf, kee);
+                        }
+                      });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.vf.size(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        NarrowBuffer& out = locals.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const auto [v, f] = orphans.vf[i];
+                          if (!vf_in_scope(v, f)) continue;
+                          if (!detail::overlap(ctx.vertex_box(v), ctx.face_box(f))) continue;
+                          ctx.kernel_vf(v, f, out.c, out.vf);
+                        }
+                      });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.ee.size(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        NarrowBuffer& out = locals.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const auto [ea, eb] = orphans.ee[i];
+                          if (!ee_in_scope(ea, eb)) continue;
+                          if (!detail::overlap(ctx.edge_box(ea), ctx.edge_box(eb))) continue;
+                          ctx.kernel_ee(ea, eb, out.c, out.ee);
+                        }
+                      });
+    DetectStats& st = res.stats;
+    st.triangle_pairs = pairs.size();
+    st.vf_orphans = orphans.vf.size();
+    st.ee_orphans = orphans.ee.size();
+    for (auto& l : locals) {
+      st.vf_tests += l.c.vf_tests;
+      st.ee_tests += l.c.ee_tests;
+      st.vf_np_culled += l.c.vf_np;
+      st.ee_np_culled += l.c.ee_np;
+      res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
+      res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
+    }
+    std::sort(res.vf.begin(), res.vf.end(), detail::vf_less);
+    std::sort(res.ee.begin(), res.ee.end(), detail::ee_less);
+    st.vf_collisions = res.vf.size();
+    st.ee_collisions = res.ee.size();
+  }
+
+  // Tests the feature pairs of a non-adjacent triangle pair whose representative pair it is.
+  template <class Out, class KernelVf, class KernelEe>
+  void triangle_pair(const detail::FeatureContext& ctx, int f, int g, Out& out, KernelVf&& kvf,
+                     KernelEe&& kee) const {
+    const Face& tf = topo.faces()[f];
+    const Face& tg = topo.faces()[g];
+    const detail::Box bf = ctx.face_box(f), bg = ctx.face_box(g);
+    for (int v : tf) {
+      if (!detail::overlap(ctx.vertex_box(v), bg)) continue;
+      if (detail::vf_representative(topo, v, g) != f || !vf_in_scope(v, g)) continue;
+      kvf(v, g, out);
+    }
+    for (int v : tg) {
+      if (!detail::overlap(ctx.vertex_box(v), bf)) continue;
+      if (detail::vf_representative(topo, v, f) != g || !vf_in_scope(v, f)) continue;
+      kvf(v, f, out);
+    }
+    const auto& ef = topo.face_edges(f);
+    const auto& eg = topo.face_edges(g);
+    std::array<detail::Box, 3> bxf, bxg;
+    for (int k = 0; k < 3; ++k) {
+      bxf[k] = ctx.edge_box(ef[k]);
+      bxg[k] = ctx.edge_box(eg[k]);
+    }
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        if (!detail::overlap(bxf[i], bxg[j])) continue;
+        const int ea = ef[i], eb = eg[j];
+        const bool a_first = ea < eb;
+        const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;
+        const auto rep = detail::ee_representative(topo, e1, e2);
+        const bool mine =
+            a_first ? (rep.first == f && rep.second == g) : (rep.first == g && rep.second == f);
+        if (!mine || !ee_in_scope(e1, e2)) continue;
+        kee(e1, e2, out);
+      }
+    }
+  }
+
+  DetectResult detect(const Positions& p0, const Positions& p1) {
+    detail::to_points(p0, topo.num_vertices(), "positions at t0", v0);
+    detail::to_points(p1, topo.num_vertices(), "positions at t1", v1);
+    DetectResult res;
+    DetectStats& st = res.stats;
+    auto t = Clock::now();
+    RefitOptions ro;
+    ro.thickness = opt.thickness;
+    ro.cones = cones_used(opt.culling);
+    ro.policy = opt.policy;
+    bvh.refit(v0, v1, ro);
+    st.time_refit = seconds_since(t);
+    st.internal_nodes = bvh.num_internal();
+    st.connected_internal_nodes = bvh.num_connected_internal();
+    st.disk_internal_nodes = bvh.num_disk_internal();
+
+    t = Clock::now();
+    const auto pairs = traverse(opt.culling, st);
+    st.time_traverse = seconds_since(t);
+    t = Clock::now();
+    narrow(pairs, res);
+    st.time_narrow = seconds_since(t);
+
+    if (opt.verify && opt.culling != Culling::None) {
+      DetectResult ref;
+      const auto all = traverse(Culling::None, ref.stats);
+      narrow(all, ref);
+      res.verified = true;
+      res.unculled_triangle_pairs = all.size();
+      std::set_difference(ref.vf.begin(), ref.vf.end(), res.vf.begin(), res.vf.end(),
+                          std::back_inserter(res.missed_vf), detail::vf_less);
+      std::set_difference(ref.ee.begin(), ref.ee.end(), res.ee.begin(), res.ee.end(),
+                          std::back_inserter(res.missed_ee), detail::ee_less);
+    }
+    return res;
+  }
+
+  ProximityResult proximity(const Positions& p, double h) {
+    if (!(h >= 0) || !std::isfinite(h)) {
+      throw InputError(fmt::format("proximity distance must be finite and >= 0, got {}", h));
+    }
+    detail::to_points(p, topo.num_vertices(), "positions", v0);
+    v1 = v0;
+    RefitOptions ro;
+    ro.thickness = h;
+    ro.cones = false;  // cones carry no distance information (algorithms.md 1.1)
+    bvh.refit(v0, ro);
+    DetectStats st;
+    const auto pairs = traverse(Culling::None, st);
+    detail::FeatureContext ctx;
+    ctx.topo = &topo;
+    ctx.v0 = v0;
+    ctx.v1 = v1;
+    ctx.margin = 0.5 * h;
+    struct Buffer {
+      std::vector<ProximityResult::VertexFace> vf;
+      std::vector<ProximityResult::EdgeEdge> ee;
+    };
+    tbb::enumerable_thread_specific<Buffer> locals;
+    auto kvf = [&](int v, int f, Buffer& out) {
+      const Face& t = topo.faces()[f];
+      const double d = point_triangle_proximity(v0[v], v0[t[0]], v0[t[1]], v0[t[2]]).distance;
+      if (d <= h) out.vf.push_back({v, f, d});
+    };
+    auto kee = [&](int a, int b, Buffer& out) {
+      const Edge &ea = topo.edges()[a], &eb = topo.edges()[b];
+      const double d = edge_edge_proximity(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]]).distance;
+      if (d <= h) out.ee.push_back({a, b, d});
+    };
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        Buffer& out = locals.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          triangle_pair(ctx, pairs[i].first, pairs[i].second, out, kvf, kee);
+                        }
+                      });
+    Buffer& out = locals.local();
+    for (const auto& [v, f] : orphans.vf) {
+      if (vf_in_scope(v, f) && detail::overlap(ctx.vertex_box(v), ctx.face_box(f))) kvf(v, f, out);
+    }
+    for (const auto& [a, b] : orphans.ee) {
+      if (ee_in_scope(a, b) && detail::overlap(ctx.edge_box(a), ctx.edge_box(b))) kee(a, b, out);
+    }
+    ProximityResult res;
+    for (const auto& l : locals) {
+      res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
+      res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
+    }
+    std::sort(res.vf.begin(), res.vf.end(), [](const auto& a, const auto& b) {
+      return std::pair(a.vertex, a.face) < std::pair(b.vertex, b.face);
+    });
+    std::sort(res.ee.begin(), res.ee.end(), [](const auto& a, const auto& b) {
+      return std::pair(a.edge_a, a.edge_b) < std::pair(b.edge_a, b.edge_b);
+    });
+    return res;
+  }
+
+  void set_active(std::span<const int> active_faces) {
+    const int nf = topo.num_faces();
+    face_active.assign(nf, 0);
+    vertex_active.assign(topo.num_vertices(), 0);
+    edge_active.assign(topo.num_edges(), 0);
+    for (int f : active_faces) {
+      if (f < 0 || f >= nf) {
+        throw InputError(fmt::format("active face {} is out of range [0, {})", f, nf));
+      }
+      face_active[f] = 1;
+      for (int v : topo.faces()[f])
+        vertex_active[v] = 1;
+      for (int e : topo.face_edges(f))
+        edge_active[e] = 1;
+    }
+    // A face touching an active vertex can be the representative of an in-scope pair.
+    std::vector<std::uint8_t> touch(nf, 0);
+    for (int f = 0; f < nf; ++f) {
+      for (int v : topo.faces()[f])
+        touch[f] |= vertex_active[v];
+    }
+    const auto& nodes = bvh.nodes();
+    node_active.assign(nodes.size(), 0);
+    for (int i = static_cast<int>(nodes.size()) - 1; i >= 0; --i) {
+      const BvhNode& n = nodes[i];
+      node_active[i] = n.is_leaf() ? touch[bvh.prim_ids()[n.first]]
+                                   : (node_active[n.left] | node_active[n.left + 1]);
+    }
+    restricted = true;
+  }
+};
+
+SelfDetector::SelfDetector(std::vector<Face> faces, int num_vertices, const Positions& reference,
+                           const DetectOptions& options)
+    : impl_(std::make_unique<Impl>(std::move(faces), num_vertices, reference, options)) {}
+SelfDetector::~SelfDetector() = default;
+SelfDetector::SelfDetector(SelfDetector&&) noexcept = default;
+SelfDetector& SelfDetector::operator=(SelfDetector&&) noexcept = default;
+
+DetectResult SelfDetector::detect(const Positions& v_t0, const Positions& v_t1) {
+  return impl_->detect(v_t0, v_t1);
+}
+ProximityResult SelfDetector::proximity(const Positions& v, double h) {
+  return impl_->proximity(v, h);
+}
+void SelfDetector::set_active_faces(std::span<const int> faces) {
+  impl_->set_active(faces);
+}
+void SelfDetector::clear_active_faces() {
+  impl_->restricted = false;
+}
+const DetectOptions& SelfDetector::options() const {
+  return impl_->opt;
+}
+void SelfDetector::set_options(const DetectOptions& options) {
+  const BvhBuild build = impl_->opt.build;
+  impl_->opt = options;
+  impl_->opt.build = build;
+}
+const Topology& SelfDetector::topology() const {
+  return impl_->topo;
+}
+const Bvh& SelfDetector::bvh() const {
+  return impl_->bvh;
+}
+
+}  // namespace clothcd
