@@ -122,8 +122,7 @@ std::vector<Poly> sturm(const Poly& p) {
   }
   return seq;
 }
-int count_roots(const Poly& p, const mpq_class& lo, const mpq_class& hi) {
-  const auto seq = sturm(p);
+int count_roots(const std::vector<Poly>& seq, const mpq_class& lo, const mpq_class& hi) {
   return sign_changes(seq, lo) - sign_changes(seq, hi);
 }
 
@@ -154,10 +153,11 @@ Roots isolate(const Poly& p) {
     bool restart = false;
     std::vector<std::pair<mpq_class, mpq_class>> stack;
     if (deg(work) >= 1) stack.emplace_back(zero, one);
+    const std::vector<Poly> seq = sturm(work);
     while (!stack.empty() && !restart) {
       auto [lo, hi] = stack.back();
       stack.pop_back();
-      const int n = count_roots(work, lo, hi);
+      const int n = count_roots(seq, lo, hi);
       if (n == 0) continue;
       if (n == 1) {
         found.push_back(Root{false, 0, lo, hi});
@@ -187,12 +187,12 @@ int sign_at_root(const Roots& rs, const Root& r, const Poly& h) {
   const Poly g = gcd(rs.work, h);
   // g divides `work`, whose only root in (lo, hi) is simple: g vanishes there iff it changes sign.
   if (deg(g) >= 1 && sign_at(g, r.lo) * sign_at(g, r.hi) < 0) return 0;
-  const Poly hs = squarefree(h);
+  const std::vector<Poly> hseq = sturm(squarefree(h));
   mpq_class lo = r.lo, hi = r.hi;
   const int slo = sign_at(rs.work, lo);
   while (true) {
     // h(root) != 0: shrinking the interval around the root eventually excludes h's roots.
-    if (sign_at(h, lo) != 0 && sign_at(h, hi) != 0 && count_roots(hs, lo, hi) == 0) {
+    if (sign_at(h, lo) != 0 && sign_at(h, hi) != 0 && count_roots(hseq, lo, hi) == 0) {
       return sign_at(h, lo);
     }
     const mpq_class mid = (lo + hi) / 2;

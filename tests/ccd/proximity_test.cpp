@@ -1,0 +1,102 @@
+// Discrete proximity against brute force (dense sampling of the triangle / both segments) and on
+// named degenerate cases with known answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "clothcd/ccd/proximity.hpp"
+
+namespace clothcd {
+namespace {
+
+using V = Eigen::Vector3d;
+
+double brute_point_triangle(const V& p, const V& a, const V& b, const V& c, int n) {
+  double best = INFINITY;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; i + j <= n; ++j) {
+      const double u = double(i) / n, v = double(j) / n;
+      best = std::min(best, (p - (a + u * (b - a) + v * (c - a))).norm());
+    }
+  }
+  return best;
+}
+
+double brute_edge_edge(const V& a0, const V& a1, const V& b0, const V& b1, int n) {
+  double best = INFINITY;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) {
+      const double s = double(i) / n, t = double(j) / n;
+      best = std::min(best, ((a0 + s * (a1 - a0)) - (b0 + t * (b1 - b0))).norm());
+    }
+  }
+  return best;
+}
+
+TEST(CcdProximity, RandomAgainstBruteForce) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<> u(-1, 1);
+    auto vec = [&] { return V(u(rng), u(rng), u(rng)); };
+    for (int i = 0; i < 100; ++i) {
+      const V p = vec(), a = vec(), b = vec(), c = vec(), d = vec();
+      const int n = 150;
+      const auto pt = point_triangle_proximity(p, a, b, c);
+      const double bpt = brute_point_triangle(p, a, b, c, n);
+      // Never above a sampled distance; below it by at most the sampling resolution.
+      const double res = 2.0 * ((b - a).norm() + (c - a).norm()) / n;
+      EXPECT_LE(pt.distance, bpt + 1e-12) << seed << " " << i;
+      EXPECT_GE(pt.distance, bpt - res) << seed << " " << i;
+      EXPECT_NEAR(pt.weights.sum(), 1.0, 1e-12);
+      EXPECT_GE(pt.weights.minCoeff(), 0.0);
+      const V from_weights = pt.weights[0] * a + pt.weights[1] * b + pt.weights[2] * c;
+      EXPECT_NEAR((from_weights - pt.closest).norm(), 0.0, 1e-12);
+      EXPECT_NEAR((p - pt.closest).norm(), pt.distance, 1e-12);
+
+      const auto ee = edge_edge_proximity(p, a, c, d);
+      const double bee = brute_edge_edge(p, a, c, d, n);
+      const double res2 = ((a - p).norm() + (d - c).norm()) / n;
+      EXPECT_LE(ee.distance, bee + 1e-12) << seed << " " << i;
+      EXPECT_GE(ee.distance, bee - res2) << seed << " " << i;
+      EXPECT_GE(ee.s, 0.0);
+      EXPECT_LE(ee.s, 1.0);
+      EXPECT_GE(ee.t, 0.0);
+      EXPECT_LE(ee.t, 1.0);
+      EXPECT_NEAR((ee.closest_a - ee.closest_b).norm(), ee.distance, 1e-12);
+    }
+  }
+}
+
+TEST(CcdProximity, DegenerateCases) {
+  const V o(0, 0, 0), x(1, 0, 0), x2(2, 0, 0), y(0, 1, 0);
+  // Triangle collapsed to a segment: distance to that segment.
+  EXPECT_NEAR(point_triangle_proximity(V(0.5, 1, 0), o, x, x2).distance, 1.0, 1e-15);
+  EXPECT_NEAR(point_triangle_proximity(V(3, 0, 0), o, x, x2).distance, 1.0, 1e-15);
+  // Triangle collapsed to a point.
+  EXPECT_NEAR(point_triangle_proximity(V(0, 3, 4), o, o, o).distance, 5.0, 1e-15);
+  // Point in the interior, above it, and beyond a corner.
+  EXPECT_NEAR(point_triangle_proximity(V(0.25, 0.25, 2), o, x, y).distance, 2.0, 1e-15);
+  const auto corner = point_triangle_proximity(V(-1, -1, 0), o, x, y);
+  EXPECT_NEAR(corner.distance, std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(corner.weights[0], 1.0, 1e-15);
+  // Parallel edges, overlapping: distance is the offset.
+  EXPECT_NEAR(edge_edge_proximity(o, x, V(0.5, 1, 0), V(1.5, 1, 0)).distance, 1.0, 1e-15);
+  // Parallel, not overlapping: end to end.
+  EXPECT_NEAR(edge_edge_proximity(o, x, V(3, 0, 0), V(4, 0, 0)).distance, 2.0, 1e-15);
+  // Collinear overlapping: touching.
+  EXPECT_NEAR(edge_edge_proximity(o, x2, x, V(3, 0, 0)).distance, 0.0, 1e-15);
+  // Zero-length edges.
+  EXPECT_NEAR(edge_edge_proximity(y, y, o, x2).distance, 1.0, 1e-15);
+  EXPECT_NEAR(edge_edge_proximity(y, y, o, o).distance, 1.0, 1e-15);
+  // Crossing skew edges: interior solution.
+  const auto skew = edge_edge_proximity(V(-1, 0, 0), V(1, 0, 0), V(0, -1, 1), V(0, 1, 1));
+  EXPECT_NEAR(skew.distance, 1.0, 1e-15);
+  EXPECT_NEAR(skew.s, 0.5, 1e-15);
+  EXPECT_NEAR(skew.t, 0.5, 1e-15);
+  EXPECT_THROW((void)edge_edge_proximity(V(NAN, 0, 0), o, o, x), std::invalid_argument);
+  EXPECT_THROW((void)point_triangle_proximity(o, o, V(0, INFINITY, 0), x), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace clothcd
