@@ -79,17 +79,25 @@ InclusionOutcome solve(const Motion& m, const InclusionParams& p) {
   int n = 0;
   stack[n++] = Box{p.t_lo, p.t_hi, 0, 1, 0, 1, 0};
   double toi = INFINITY;
+  // Boxes skipped because they could lower the time of impact by less than p.toi_tolerance: the
+  // earliest of their start times still bounds the reported time of impact from below.
+  double skipped_t0 = INFINITY;
   Corners f;
   while (n > 0) {
     const Box b = stack[--n];
-    // Only an earlier box can lower the time of impact already found.
+    // Only an earlier box can lower the time of impact already found, and only one starting
+    // more than toi_tolerance earlier is worth refining.
     if (b.t0 >= toi) continue;
+    if (b.t0 >= toi - p.toi_tolerance) {
+      skipped_t0 = std::min(skipped_t0, b.t0);
+      continue;
+    }
     // Exact: box bounds are dyadic with few bits.
     if (K == Kind::vertex_face && b.u0 + b.v0 > 1) continue;
     if (++out.boxes > p.max_boxes) {
       // Out of budget: every contact lies in a box still open, so the earliest open time is a
       // conservative time of impact.
-      double t = std::min(toi, b.t0);
+      double t = std::min({toi, skipped_t0, b.t0});
       for (int i = 0; i < n; ++i)
         t = std::min(t, stack[i].t0);
       out.hit = true;
@@ -148,7 +156,7 @@ InclusionOutcome solve(const Motion& m, const InclusionParams& p) {
     stack[n++] = hi;
     stack[n++] = lo;
   }
-  if (out.hit) out.toi = toi;
+  if (out.hit) out.toi = std::min(toi, skipped_t0);
   return out;
 }
 

@@ -16,6 +16,7 @@ struct InclusionParams {
   double t_lo = 0, t_hi = 1;  ///< the time range searched (dyadic bounds)
   double thickness = 0;       ///< scaled
   double tolerance = 0;       ///< scaled absolute width of F below which a box counts as a hit
+  double toi_tolerance = 0;   ///< the reported time of impact may be this much early
   std::uint32_t max_boxes = 1u << 16;
 };
 

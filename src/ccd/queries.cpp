@@ -30,6 +30,10 @@ void check_options(const CcdOptions& opt) {
     throw std::invalid_argument(
         fmt::format("CCD thickness must be finite and >= 0, got {}", opt.thickness));
   }
+  if (!(opt.toi_tolerance >= 0) || !std::isfinite(opt.toi_tolerance)) {
+    throw std::invalid_argument(
+        fmt::format("CCD toi_tolerance must be finite and >= 0, got {}", opt.toi_tolerance));
+  }
   if (!(opt.tolerance > 0) || !std::isfinite(opt.tolerance)) {
     throw std::invalid_argument(
         fmt::format("CCD tolerance must be finite and > 0, got {}", opt.tolerance));
@@ -63,6 +67,7 @@ CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
   ccd_detail::InclusionParams p;
   p.thickness = opt.thickness * m.scale;
   p.tolerance = opt.tolerance * m.extent;
+  p.toi_tolerance = opt.toi_tolerance;
   p.max_boxes = opt.max_boxes;
 
   if (opt.fast_path && opt.thickness == 0) {

@@ -33,6 +33,9 @@ struct CcdOptions {
   /// Relative size (times the query's extent) below which the inclusion solver stops splitting a
   /// box it cannot reject and reports a hit. Smaller: fewer false positives, more time.
   double tolerance = 1e-6;
+  /// The reported time of impact is within this of the earliest box the solver could not reject
+  /// (always on the early side). 0 refines it fully, which costs more on colliding queries.
+  double toi_tolerance = 1e-4;
   /// Boxes the inclusion solver may visit per query; past it the query is reported as a hit with
   /// the earliest time still open (conservative, bounded time).
   std::uint32_t max_boxes = 1u << 16;
