@@ -1,0 +1,51 @@
+#pragma once
+/// @file
+/// Scene files (JSON, see docs/simulator.md of this repository for the keys): the cloth (from an
+/// OBJ prefix or a procedural grid), its material, the body (OBJ frame sequence or sphere), pins,
+/// frames and substep rules. Strings may use `${CLOTHCD_DATA}`: the environment variable when
+/// set, else `../shared/data` relative to the repository holding the scene (the scene file's
+/// folder's parent). Other relative paths are relative to the scene file.
+
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "clothcd/sim/body.hpp"
+#include "clothcd/sim/cloth_model.hpp"
+#include "clothcd/sim/integrator.hpp"
+
+namespace clothcd::sim {
+
+struct SubstepRule {
+  int min = 4;
+  int max = 32;
+  double displacement = 0.04;  ///< one substep per this much body motion (m)
+  /// n = clamp(ceil(body displacement in the frame / displacement), min, max)
+  [[nodiscard]] int count(double body_displacement) const;
+};
+
+struct Scene {
+  std::string name;
+  std::filesystem::path file;
+  ClothMeshInput cloth;
+  ClothMaterial material;
+  SolverOptions solver;
+  std::vector<PinGroup> pins;
+  std::unique_ptr<Body> body;  ///< null: no body
+  double frame_dt = 0.04;
+  int frames = 120;
+  SubstepRule substeps;
+  std::string output_format = "obj";  ///< "obj" or "ply"
+};
+
+/// Reads and validates a scene. Throws clothcd::InputError naming the scene file and the key
+/// (unknown keys, wrong types, missing files, bad values).
+[[nodiscard]] Scene load_scene(const std::filesystem::path& file);
+/// The same from parsed JSON; `file` names the scene in messages and anchors relative paths.
+[[nodiscard]] Scene parse_scene(const nlohmann::json& j, const std::filesystem::path& file);
+
+/// The `${CLOTHCD_DATA}` value for a scene file.
+[[nodiscard]] std::filesystem::path data_root_for(const std::filesystem::path& scene_file);
+
+}  // namespace clothcd::sim

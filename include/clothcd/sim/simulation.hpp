@@ -1,0 +1,52 @@
+#pragma once
+/// @file
+/// A scene in motion: frame by frame, with adaptive substeps from the body's motion
+/// (n = clamp(ceil(displacement / 4 cm), 4, 32); docs/simulator.md 4).
+
+#include <memory>
+
+#include "clothcd/sim/scene.hpp"
+
+namespace clothcd::sim {
+
+/// Figures of one frame, as written to the manifest.
+struct FrameStats {
+  int frame = 0;  ///< the frame reached (1 = first simulated frame)
+  double time = 0.0;
+  int substeps = 0;
+  int solves = 0;
+  long long pcg_iterations = 0;
+  int max_pcg_iterations = 0;
+  int halvings = 0;
+  bool pcg_converged = true;
+  double seconds = 0.0;
+  double collision_seconds = 0.0;
+  double max_stretch = 0.0;  ///< at the end of the frame
+  double body_displacement = 0.0;
+  bool finite = true;
+};
+
+class Simulation {
+ public:
+  /// Takes the scene's body and pins. Throws InputError on inconsistent pins.
+  explicit Simulation(Scene scene);
+
+  [[nodiscard]] const Scene& scene() const { return scene_; }
+  [[nodiscard]] const ClothModel& model() const { return *model_; }
+  [[nodiscard]] ClothSolver& solver() { return *solver_; }
+  [[nodiscard]] ClothState& state() { return state_; }
+  [[nodiscard]] int frame() const { return frame_; }
+  /// Replaces the state (resume); `frame` is the frame it belongs to.
+  void set_state(ClothState state, int frame);
+
+  FrameStats advance_frame();
+
+ private:
+  Scene scene_;
+  std::unique_ptr<ClothModel> model_;
+  std::unique_ptr<ClothSolver> solver_;
+  ClothState state_;
+  int frame_ = 0;
+};
+
+}  // namespace clothcd::sim

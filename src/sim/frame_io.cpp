@@ -1,0 +1,251 @@
+// Atomic output files, the binary state, the manifest and the run loop with resume.
+#include "clothcd/sim/frame_io.hpp"
+
+#include <fmt/format.h>
+
+#include <bit>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+
+#include "clothcd/core/error.hpp"
+
+namespace clothcd::sim {
+namespace {
+
+constexpr char kStateMagic[8] = {'C', 'L', 'O', 'T', 'H', 'S', 'T', '1'};
+
+std::string frame_name(int frame, const std::string& ext) {
+  return fmt::format("frame_{:04d}.{}", frame, ext);
+}
+std::string state_name(int frame) {
+  return fmt::format("state_{:04d}.bin", frame);
+}
+
+template <typename T>
+void put(std::ostream& out, const T& v) {
+  out.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+void put_vecs(std::ostream& out, const std::vector<Vec3>& xs) {
+  out.write(reinterpret_cast<const char*>(xs.data()),
+            static_cast<std::streamsize>(xs.size() * sizeof(Vec3)));
+}
+
+}  // namespace
+
+void write_file_atomic(const std::filesystem::path& path,
+                       const std::function<void(std::ostream&)>& write) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) {
+      throw std::runtime_error(
+          fmt::format("cannot create '{}': {}", tmp.string(), std::strerror(errno)));
+    }
+    write(out);
+    out.flush();
+    out.close();
+    if (out.fail()) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw std::runtime_error(
+          fmt::format("writing '{}' failed (disk full or output not writable?)", path.string()));
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(
+        fmt::format("cannot rename '{}' to '{}': {}", tmp.string(), path.string(), ec.message()));
+  }
+}
+
+void write_mesh_atomic(const std::filesystem::path& path, const std::vector<Vec3>& x,
+                       const std::vector<Face>& faces, const std::string& format) {
+  write_file_atomic(path, [&](std::ostream& out) {
+    if (format == "ply") {
+      out << "ply\nformat binary_little_endian 1.0\n"
+          << "element vertex " << x.size() << "\nproperty float x\nproperty float y\n"
+          << "property float z\nelement face " << faces.size()
+          << "\nproperty list uchar int vertex_indices\nend_header\n";
+      std::vector<char> buf;
+      buf.reserve(x.size() * 12 + faces.size() * 13);
+      auto append = [&buf](const void* p, std::size_t n) {
+        buf.insert(buf.end(), static_cast<const char*>(p), static_cast<const char*>(p) + n);
+      };
+      static_assert(std::endian::native == std::endian::little, "PLY writer assumes little endian");
+      for (const Vec3& p : x) {
+        const float f[3] = {static_cast<float>(p.x()), static_cast<float>(p.y()),
+                            static_cast<float>(p.z())};
+        append(f, sizeof f);
+      }
+      for (const Face& f : faces) {
+        const unsigned char three = 3;
+        append(&three, 1);
+        const std::int32_t idx[3] = {f[0], f[1], f[2]};
+        append(idx, sizeof idx);
+      }
+      out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
+    } else {
+      std::string s;
+      s.reserve(x.size() * 40 + faces.size() * 24);
+      for (const Vec3& p : x)
+        fmt::format_to(std::back_inserter(s), "v {:.9g} {:.9g} {:.9g}\n", p.x(), p.y(), p.z());
+      for (const Face& f : faces) {
+        fmt::format_to(std::back_inserter(s), "f {} {} {}\n", f[0] + 1, f[1] + 1, f[2] + 1);
+      }
+      out.write(s.data(), static_cast<std::streamsize>(s.size()));
+    }
+  });
+}
+
+void write_state_atomic(const std::filesystem::path& path, const ClothState& state, int frame) {
+  write_file_atomic(path, [&](std::ostream& out) {
+    out.write(kStateMagic, sizeof kStateMagic);
+    put(out, static_cast<std::int64_t>(state.x.size()));
+    put(out, static_cast<std::int64_t>(frame));
+    put(out, state.time);
+    put_vecs(out, state.x);
+    put_vecs(out, state.v);
+    put_vecs(out, state.dv);
+  });
+}
+
+ClothState read_state(const std::filesystem::path& path, int num_vertices, int& frame) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw input_error(path.string(), 0, "cannot open state file");
+  char magic[8];
+  std::int64_t n = 0, f = 0;
+  ClothState s;
+  in.read(magic, sizeof magic);
+  in.read(reinterpret_cast<char*>(&n), sizeof n);
+  in.read(reinterpret_cast<char*>(&f), sizeof f);
+  in.read(reinterpret_cast<char*>(&s.time), sizeof s.time);
+  if (!in || std::memcmp(magic, kStateMagic, sizeof magic) != 0) {
+    throw input_error(path.string(), 0, "not a clothcd state file");
+  }
+  if (n != num_vertices) {
+    throw input_error(
+        path.string(), 0,
+        fmt::format("state has {} vertices, the scene's cloth has {}", n, num_vertices));
+  }
+  for (std::vector<Vec3>* v : {&s.x, &s.v, &s.dv}) {
+    v->resize(n);
+    in.read(reinterpret_cast<char*>(v->data()), static_cast<std::streamsize>(n * sizeof(Vec3)));
+  }
+  if (!in) throw input_error(path.string(), 0, "state file is truncated");
+  frame = static_cast<int>(f);
+  return s;
+}
+
+nlohmann::json to_json(const FrameStats& s) {
+  return {{"frame", s.frame},
+          {"time", s.time},
+          {"substeps", s.substeps},
+          {"solves", s.solves},
+          {"pcg_iterations", s.pcg_iterations},
+          {"max_pcg_iterations", s.max_pcg_iterations},
+          {"halvings", s.halvings},
+          {"pcg_converged", s.pcg_converged},
+          {"seconds", s.seconds},
+          {"collision_seconds", s.collision_seconds},
+          {"max_stretch", s.max_stretch},
+          {"body_displacement", s.body_displacement},
+          {"intersecting_pairs", nullptr},  // no collision stage yet
+          {"finite", s.finite}};
+}
+
+std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
+  namespace fs = std::filesystem;
+  const Scene& scene = sim.scene();
+  const int total = opt.frames >= 0 ? opt.frames : scene.frames;
+  const std::string ext = scene.output_format;
+  const auto& faces = sim.model().topology().faces();
+  const int n = sim.model().num_vertices();
+  std::error_code ec;
+  fs::create_directories(opt.out, ec);
+  if (ec || !fs::is_directory(opt.out)) {
+    throw std::runtime_error(fmt::format("cannot create output folder '{}': {}", opt.out.string(),
+                                         ec ? ec.message() : "not a folder"));
+  }
+  const fs::path manifest_path = opt.out / "manifest.json";
+  nlohmann::json manifest;
+  int done = 0;
+  if (opt.resume && fs::exists(manifest_path)) {
+    std::ifstream in(manifest_path);
+    try {
+      manifest = nlohmann::json::parse(in);
+      done = manifest.at("complete_frames").get<int>();
+      if (manifest.at("vertices").get<int>() != n ||
+          manifest.at("scene").get<std::string>() != scene.name) {
+        throw input_error(manifest_path.string(), 0,
+                          fmt::format("made by another scene or cloth ('{}', {} vertices), not by "
+                                      "'{}' ({} vertices)",
+                                      manifest.at("scene").get<std::string>(),
+                                      manifest.at("vertices").get<int>(), scene.name, n));
+      }
+    } catch (const nlohmann::json::exception& e) {
+      throw input_error(manifest_path.string(), 0,
+                        fmt::format("unreadable manifest: {}", e.what()));
+    }
+    int state_frame = -1;
+    ClothState st =
+        read_state(opt.out / manifest.at("state_file").get<std::string>(), n, state_frame);
+    if (state_frame != done) {
+      throw input_error(
+          manifest_path.string(), 0,
+          fmt::format("state file is for frame {}, manifest says {}", state_frame, done));
+    }
+    sim.set_state(std::move(st), done);
+    auto& frames = manifest["frames"];
+    while (!frames.empty() && frames.back().at("frame").get<int>() > done)
+      frames.erase(frames.size() - 1);
+  } else {
+    manifest = {{"format_version", 1},
+                {"scene", scene.name},
+                {"scene_file", fs::absolute(scene.file).string()},
+                {"vertices", n},
+                {"faces", faces.size()},
+                {"frame_dt", scene.frame_dt},
+                {"mesh_format", ext},
+                {"slivers", sim.model().num_slivers()},
+                {"stitches", sim.model().stitches().size()},
+                {"collisions", false},
+                {"frames", nlohmann::json::array()}};
+    write_mesh_atomic(opt.out / frame_name(0, ext), sim.state().x, faces, ext);
+    const std::string sname = state_name(0);
+    write_state_atomic(opt.out / sname, sim.state(), 0);
+    manifest["complete_frames"] = 0;
+    manifest["state_file"] = sname;
+    write_file_atomic(manifest_path, [&](std::ostream& o) { o << manifest.dump(1) << '\n'; });
+  }
+  std::vector<FrameStats> out;
+  while (sim.frame() < total) {
+    const FrameStats fst = sim.advance_frame();
+    const int k = fst.frame;
+    write_mesh_atomic(opt.out / frame_name(k, ext), sim.state().x, faces, ext);
+    const std::string old_state = manifest["state_file"].get<std::string>();
+    const std::string sname = state_name(k);
+    write_state_atomic(opt.out / sname, sim.state(), k);
+    manifest["frames"].push_back(to_json(fst));
+    manifest["complete_frames"] = k;
+    manifest["state_file"] = sname;
+    write_file_atomic(manifest_path, [&](std::ostream& o) { o << manifest.dump(1) << '\n'; });
+    fs::remove(opt.out / old_state, ec);  // the manifest no longer points at it
+    out.push_back(fst);
+    if (opt.on_frame) opt.on_frame(fst, total);
+    if (!fst.finite) {
+      throw std::runtime_error(
+          fmt::format("frame {}: the state is not finite (NaN or inf); "
+                      "stopped, see {}",
+                      k, manifest_path.string()));
+    }
+  }
+  return out;
+}
+
+}  // namespace clothcd::sim

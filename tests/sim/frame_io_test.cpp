@@ -1,0 +1,144 @@
+// Atomic output, state round trip, and resume that matches a straight run bitwise.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <iterator>
+
+#include "clothcd/core/error.hpp"
+#include "clothcd/sim/frame_io.hpp"
+#include "hash.hpp"
+
+namespace clothcd::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+Scene test_scene() {
+  return parse_scene(nlohmann::json::parse(R"({
+    "name": "resume-test",
+    "frames": 5,
+    "cloth": {"grid": {"origin": [0, 1, 0], "u": [0.3, 0, 0], "v": [0, 0, 0.3], "resolution": [12, 12]}},
+    "pins": [{"vertices": [0, 12]}],
+    "body": {"type": "sphere", "center": [0.15, 0.5, 0.15], "radius": 0.1, "velocity": [0, 1.5, 0]}
+  })"),
+                     "resume-test.json");
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+struct TempDir {
+  fs::path path =
+      fs::temp_directory_path() / ("clothcd_sim_" + std::to_string(::getpid()) + "_" +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  TempDir() { fs::remove_all(path); }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+TEST(FrameIo, StateRoundTripIsExact) {
+  TempDir dir;
+  fs::create_directories(dir.path);
+  Simulation sim(test_scene());
+  sim.advance_frame();
+  write_state_atomic(dir.path / "s.bin", sim.state(), 1);
+  int frame = -1;
+  const ClothState back = read_state(dir.path / "s.bin", sim.model().num_vertices(), frame);
+  EXPECT_EQ(frame, 1);
+  EXPECT_EQ(test::hash_positions(back.x), test::hash_positions(sim.state().x));
+  EXPECT_EQ(test::hash_positions(back.v), test::hash_positions(sim.state().v));
+  EXPECT_EQ(test::hash_positions(back.dv), test::hash_positions(sim.state().dv));
+  EXPECT_EQ(back.time, sim.state().time);
+  EXPECT_THROW((void)read_state(dir.path / "s.bin", 3, frame), InputError);
+}
+
+TEST(FrameIo, AtomicWriteLeavesNoTemporaryAndReplacesWhole) {
+  TempDir dir;
+  fs::create_directories(dir.path);
+  write_file_atomic(dir.path / "f.txt", [](std::ostream& o) { o << "first version, long"; });
+  write_file_atomic(dir.path / "f.txt", [](std::ostream& o) { o << "second"; });
+  EXPECT_EQ(slurp(dir.path / "f.txt"), "second");
+  EXPECT_FALSE(fs::exists(dir.path / "f.txt.tmp"));
+  // A folder that cannot be created: a clear runtime_error, nothing left behind.
+  EXPECT_THROW(write_file_atomic(dir.path / "missing" / "f.txt", [](std::ostream&) {}),
+               std::runtime_error);
+}
+
+TEST(FrameIo, DiskFullIsReported) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "/dev/full not available";
+  TempDir dir;
+  fs::create_directories(dir.path);
+  // The temporary file is a link to /dev/full, which fails every write like a full disk.
+  fs::create_symlink("/dev/full", dir.path / "f.txt.tmp");
+  try {
+    write_file_atomic(dir.path / "f.txt", [](std::ostream& o) { o << std::string(1 << 16, 'x'); });
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("disk full"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir.path / "f.txt"));
+  EXPECT_FALSE(fs::is_symlink(dir.path / "f.txt.tmp"));
+}
+
+TEST(FrameIo, ResumeMatchesStraightRunBitwise) {
+  TempDir dir;
+  const fs::path straight = dir.path / "straight", resumed = dir.path / "resumed";
+  {
+    Simulation sim(test_scene());
+    RunOptions opt;
+    opt.out = straight;
+    const auto frames = run_simulation(sim, opt);
+    ASSERT_EQ(frames.size(), 5u);
+    for (const auto& f : frames)
+      EXPECT_TRUE(f.finite);
+  }
+  {
+    Simulation sim(test_scene());
+    RunOptions opt;
+    opt.out = resumed;
+    opt.frames = 3;
+    EXPECT_EQ(run_simulation(sim, opt).size(), 3u);
+  }
+  {
+    Simulation sim(test_scene());  // a fresh process would start like this
+    RunOptions opt;
+    opt.out = resumed;
+    opt.resume = true;
+    const auto frames = run_simulation(sim, opt);
+    ASSERT_EQ(frames.size(), 2u);
+    EXPECT_EQ(frames.front().frame, 4);
+  }
+  for (int k = 0; k <= 5; ++k) {
+    const std::string name = "frame_000" + std::to_string(k) + ".obj";
+    EXPECT_EQ(slurp(straight / name), slurp(resumed / name)) << name;
+  }
+  EXPECT_EQ(slurp(straight / "state_0005.bin"), slurp(resumed / "state_0005.bin"));
+  EXPECT_FALSE(fs::exists(resumed / "state_0003.bin"));  // only the last state is kept
+  const auto manifest = nlohmann::json::parse(slurp(resumed / "manifest.json"));
+  EXPECT_EQ(manifest["complete_frames"], 5);
+  ASSERT_EQ(manifest["frames"].size(), 5u);
+  for (int k = 0; k < 5; ++k)
+    EXPECT_EQ(manifest["frames"][k]["frame"], k + 1);
+  // Resuming a finished run does nothing.
+  Simulation sim(test_scene());
+  RunOptions opt;
+  opt.out = resumed;
+  opt.resume = true;
+  EXPECT_TRUE(run_simulation(sim, opt).empty());
+}
+
+TEST(FrameIo, PlyOutputHasHeaderAndBinaryBody) {
+  TempDir dir;
+  fs::create_directories(dir.path);
+  const std::vector<Vec3> x{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  write_mesh_atomic(dir.path / "m.ply", x, {{0, 1, 2}}, "ply");
+  const std::string s = slurp(dir.path / "m.ply");
+  const auto end = s.find("end_header\n");
+  ASSERT_NE(end, std::string::npos);
+  EXPECT_EQ(s.size() - end - 11, 3u * 12u + 13u);
+}
+
+}  // namespace
+}  // namespace clothcd::sim

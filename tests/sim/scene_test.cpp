@@ -1,0 +1,185 @@
+// Scene JSON validation, procedural scenes, the substep rule and OBJ reading.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "clothcd/core/error.hpp"
+#include "clothcd/sim/obj_reader.hpp"
+#include "clothcd/sim/scene.hpp"
+#include "clothcd/sim/sewing.hpp"
+#include "support/data.hpp"
+
+namespace clothcd::sim {
+namespace {
+
+using nlohmann::json;
+
+json small_grid_scene() {
+  return json::parse(R"({
+    "name": "small",
+    "frames": 2,
+    "cloth": {"grid": {"origin": [0, 1, 0], "u": [0.2, 0, 0], "v": [0, 0, 0.2], "resolution": [4, 4]}},
+    "pins": [{"grid_edge": "u0"}]
+  })");
+}
+
+/// The InputError message of parsing `j`, or "" when it parsed.
+std::string error_of(const json& j) {
+  try {
+    (void)parse_scene(j, "test-scene.json");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Scene, SmallGridParses) {
+  const Scene s = parse_scene(small_grid_scene(), "test-scene.json");
+  EXPECT_EQ(s.cloth.positions.size(), 25u);
+  EXPECT_EQ(s.cloth.faces.size(), 32u);
+  ASSERT_EQ(s.pins.size(), 1u);
+  EXPECT_EQ(s.pins[0].vertices.size(), 5u);
+  EXPECT_EQ(s.frames, 2);
+}
+
+TEST(Scene, ValidationErrorsNameFileAndKey) {
+  struct Case {
+    const char* name;
+    std::function<void(json&)> edit;
+    const char* expect;  // substring of the message
+  };
+  const std::vector<Case> cases = {
+      {"unknown top key", [](json& j) { j["framez"] = 3; }, "'framez': unknown key"},
+      {"unknown nested key", [](json& j) { j["cloth"]["grid"]["resolutoin"] = 1; },
+       "'cloth.grid.resolutoin': unknown key"},
+      {"wrong type", [](json& j) { j["frames"] = "many"; }, "'frames': expected an integer"},
+      {"missing name", [](json& j) { j.erase("name"); }, "'name': missing"},
+      {"bad vector",
+       [](json& j) {
+         j["gravity"] = json::array({0, 1});
+       },
+       "'gravity': expected an array of 3 numbers"},
+      {"out of range",
+       [](json& j) {
+         j["material"] = {{"poisson", 0.7}};
+       },
+       "'material.poisson': 0.7 is outside"},
+      {"bad enum",
+       [](json& j) {
+         j["output"] = {{"format", "stl"}};
+       },
+       "'output.format': 'stl' is not one of"},
+      {"missing file",
+       [](json& j) {
+         j["cloth"] = {{"obj", "no/such/cloth.obj"}};
+       },
+       "'cloth.obj': file"},
+      {"pin out of range",
+       [](json& j) {
+         j["pins"] = json::array({{{"vertices", {0, 999}}}});
+       },
+       "'pins[0].vertices': 999 is not a vertex id"},
+      {"bad body type",
+       [](json& j) {
+         j["body"] = {{"type", "cube"}};
+       },
+       "'body.type'"},
+      {"frames without placeholder",
+       [](json& j) {
+         j["body"] = {{"type", "frames"}, {"frames", "x.obj"}, {"count", 2}};
+       },
+       "'{}' standing for the frame number"},
+  };
+  for (const Case& c : cases) {
+    json j = small_grid_scene();
+    c.edit(j);
+    const std::string msg = error_of(j);
+    EXPECT_NE(msg.find("test-scene.json"), std::string::npos) << c.name << ": " << msg;
+    EXPECT_NE(msg.find(c.expect), std::string::npos) << c.name << ": " << msg;
+  }
+}
+
+TEST(Scene, SubstepRule) {
+  const SubstepRule r;
+  EXPECT_EQ(r.count(0.0), 4);
+  EXPECT_EQ(r.count(0.083), 4);
+  EXPECT_EQ(r.count(0.2), 5);
+  EXPECT_EQ(r.count(0.66), 17);  // the fastest Kick frame, as in docs/simulator.md 4
+  EXPECT_EQ(r.count(10.0), 32);
+}
+
+std::filesystem::path repo_scene(const char* name) {
+  return std::filesystem::path(CLOTHCD_SOURCE_DIR) / "scenes" / name;
+}
+
+TEST(Scene, ProceduralScenesLoadWithoutData) {
+  for (const char* name : {"sphere-drop.json", "twist.json"}) {
+    const Scene s = load_scene(repo_scene(name));
+    EXPECT_GE(s.cloth.faces.size(), 20000u) << name;
+    EXPECT_TRUE(s.body || !s.pins.empty()) << name;
+  }
+}
+
+TEST(Scene, DataScenesLoad) {
+  CLOTHCD_REQUIRE_DATA(body, "body/rumba/0.obj");
+  const Scene s = load_scene(repo_scene("dress-rumba.json"));
+  EXPECT_EQ(s.cloth.positions.size(), 15656u);
+  EXPECT_EQ(s.cloth.faces.size(), 29456u);
+  EXPECT_EQ(s.cloth.stitches.size(), 851u);
+  EXPECT_EQ(s.cloth.pattern.size(), 15656u);
+  ASSERT_TRUE(s.body);
+  EXPECT_EQ(s.body->num_vertices(), 12811);
+  // Frame 0 of the motion is the drape's pose once the drape is lifted by 0.75 m.
+  std::vector<Vec3> b0;
+  s.body->positions_at(0.0, b0);
+  const ObjData drape =
+      read_obj(body.parent_path().parent_path().parent_path() / "garments/dress_knife/drape.obj");
+  double worst = 0.0;
+  for (int i = 0; i < 12811; ++i) {
+    worst = std::max(worst, (drape.positions[15656 + i] + Vec3(0, 0.75, 0) - b0[i]).norm());
+  }
+  EXPECT_LT(worst, 1e-3);
+}
+
+TEST(Sewing, RecoversTiesBetweenPanels) {
+  // Two unit squares side by side, 0.5 mm apart: each boundary vertex on the gap ties across.
+  std::vector<Vec3> x{{0, 0, 0},      {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                      {1.0005, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1.0005, 1, 0}};
+  std::vector<Face> f{{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+  const auto ties = recover_stitches(x, f, 1e-3);
+  ASSERT_EQ(ties.size(), 4u);
+  EXPECT_EQ(ties[0].a, 1);
+  EXPECT_EQ(ties[1].a, 2);
+  EXPECT_EQ(ties[2].a, 4);
+  EXPECT_EQ(ties[3].a, 7);
+  EXPECT_TRUE(recover_stitches(x, f, 1e-4).empty());
+}
+
+TEST(ObjReader, ReadsFacesTexcoordsStitchesAndReportsLines) {
+  const auto dir = std::filesystem::temp_directory_path() / "clothcd_sim_obj_test";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream o(dir / "a.obj");
+    o << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+         "f 1/1 2/2 3/3 4/4\nstitch 0 1 2 0.5\n";
+  }
+  const ObjData d = read_obj(dir / "a.obj");
+  EXPECT_EQ(d.faces.size(), 2u);
+  EXPECT_EQ(d.face_texcoords[1][2], 3);
+  ASSERT_EQ(d.stitches.size(), 1u);
+  EXPECT_EQ(d.stitches[0].r, 0.5);
+  {
+    std::ofstream o(dir / "b.obj");
+    o << "v 0 0 0\nv 1 0 0\nf 1 2 7\n";
+  }
+  try {
+    (void)read_obj(dir / "b.obj");
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("b.obj:3"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace clothcd::sim
