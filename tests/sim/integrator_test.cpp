@@ -121,7 +121,7 @@ ClothState hang(ClothSolver& solver, const ClothModel& m, int nx, int steps,
 }
 
 TEST(Integrator, HangingClothSettles) {
-  const int nx = 16;
+  const int nx = 10;
   const ClothModel m(grid_cloth(nx, nx, 0.4, 0.4, 1.0), ClothMaterial{});
   ClothSolver solver(m, SolverOptions{});
   std::vector<double> ke;
