@@ -47,7 +47,8 @@ std::vector<Eigen::Vector3d> random_set(Rng& rng, int n, double spread) {
 // angle is evaluated: picking the smallest dot product first cannot resolve tiny angles.
 long double needed(const Vec3L& axis, const std::vector<Vec3L>& pts) {
   long double worst = 0;
-  for (const Vec3L& p : pts) worst = std::max(worst, angle_ld(axis, p));
+  for (const Vec3L& p : pts)
+    worst = std::max(worst, angle_ld(axis, p));
   return worst;
 }
 
