@@ -4,7 +4,7 @@ set -euo pipefail
 
 packages=(
   cmake g++ make pkg-config
-  libeigen3-dev libtbb-dev libfmt-dev libcli11-dev nlohmann-json3-dev libtinyobjloader-dev
+  libeigen3-dev libtbb-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libgmp-dev
   clang clang-format libclang-rt-14-dev
   python3-matplotlib

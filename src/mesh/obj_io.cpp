@@ -1,8 +1,7 @@
 // OBJ reading with line-level validation, and OBJ writing.
 //
-// tinyobjloader is lenient (a non-numeric coordinate becomes 0, a short `v` line is padded) and
-// Debian's configured target stores coordinates as float, so the reader is a strict line scanner
-// in double; the tests compare it with tinyobjloader on valid files.
+// A strict line scanner in double precision: lenient readers turn a non-numeric coordinate into 0
+// or pad a short `v` line, which would hide broken files.
 
 #include <fmt/format.h>
 
