@@ -12,6 +12,7 @@
 
 #include "clothcd/mesh/io.hpp"
 #include "io_test_support.hpp"
+#include "support/file_size_limit.hpp"
 
 namespace clothcd {
 namespace {
@@ -443,12 +444,38 @@ TEST(MeshWriteErrors, InvalidMeshIsNotWritten) {
 }
 
 TEST(MeshWriteErrors, DiskFull) {
-  // /dev/full fails every write with ENOSPC; its folder takes no temporary file unless we are
-  // root, in which case the rename would replace the device: only run as a normal user.
-  if (::geteuid() == 0 || !std::filesystem::exists("/dev/full")) {
-    GTEST_SKIP() << "needs a non-root user and /dev/full";
+  // A 64 KiB file-size limit stands in for a full disk (see support/file_size_limit.hpp for why
+  // not /dev/full): the write fails, the message says so, the old target survives and no
+  // temporary file is left.
+  ScratchDir dir;
+  TriangleMesh big;
+  const int n = 60;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i)
+      big.vertices.emplace_back(i / 3.0, j / 7.0, 0.1 * i * j);
   }
-  expect_input_error([&] { write_obj("/dev/full", random_mesh(0)); }, {"/dev/full"});
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i;
+      big.faces.push_back({a, a + 1, a + n + 2});
+      big.faces.push_back({a, a + n + 2, a + n + 1});
+    }
+  }
+  const TriangleMesh small = random_mesh(1);
+  for (const char* name : {"m.obj", "m.ply"}) {
+    const auto target = dir.path() / name;
+    write_mesh(target, small);
+    {
+      test::FileSizeLimit full(64 * 1024);
+      ASSERT_TRUE(full.active());
+      expect_input_error([&] { write_mesh(target, big); }, {name, "write failed"});
+    }
+    EXPECT_EQ(read_mesh(target), small);
+  }
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir.path()))
+    ++files;
+  EXPECT_EQ(files, 2);
 }
 
 TEST(FramePair, SameTopologyPasses) {
