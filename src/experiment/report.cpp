@@ -1,0 +1,411 @@
+// Tables of the experiment (markdown) and the merged CSVs, from the per-(scene, build) runs.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <numeric>
+
+#include "clothcd/experiment/experiment.hpp"
+#include "records.hpp"
+
+namespace clothcd::experiment {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The paper's Table 1 (average triangle pair tests) and Table 2 (ms: BVH construction, CD,
+// total), PROVOT then PROPOSED.
+struct PaperRow {
+  const char* scene;
+  int triangles;
+  double pairs_provot, pairs_proposed;
+  double bvh_provot, bvh_proposed, cd_provot, cd_proposed, total_provot, total_proposed;
+};
+constexpr PaperRow kPaper[] = {
+    {"Ensemble 1", 18920, 39997.78, 30795.03, 3.03, 3.67, 17.17, 12.72, 20.12, 16.39},
+    {"Ensemble 2", 34877, 87607.41, 60140.21, 8.52, 11.86, 37.77, 22.10, 46.29, 33.97},
+    {"Onepiece 1", 20849, 50518.85, 39499.42, 3.96, 4.61, 18.01, 14.29, 21.97, 18.90},
+    {"Onepiece 2", 61949, 165412.73, 122977.72, 11.93, 14.06, 62.69, 48.33, 74.62, 62.40},
+};
+
+std::string grouped(double v, int decimals = 0) {
+  if (std::isnan(v)) return "-";
+  std::string s = fmt::format("{:.{}f}", std::abs(v), decimals);
+  const auto dot = s.find('.');
+  std::string head = s.substr(0, dot), tail = dot == std::string::npos ? "" : s.substr(dot);
+  std::string out;
+  for (std::size_t i = 0; i < head.size(); ++i) {
+    if (i > 0 && (head.size() - i) % 3 == 0) out += ',';
+    out += head[i];
+  }
+  return (v < 0 ? "-" : "") + out + tail;
+}
+
+std::string pct(double v) {
+  return std::isnan(v) ? std::string("-") : fmt::format("{:+.1f}%", 100.0 * v);
+}
+
+// 1 - x / base, NaN when the base is zero.
+double reduction(double x, double base) {
+  return base > 0 ? 1.0 - x / base : std::nan("");
+}
+
+double mean(const std::vector<double>& v) {
+  return v.empty() ? std::nan("") : std::accumulate(v.begin(), v.end(), 0.0) / double(v.size());
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct Agg {
+  int calls = 0;
+  std::vector<double> pairs, vf, ee, culled, refit, cd, total;
+  double missed_vf = 0, missed_ee = 0, extra = 0, ref_vf = 0, ref_ee = 0;
+  int steps_missing = 0;
+};
+
+struct ConfigKey {
+  std::string build, culling, policy;
+  auto operator<=>(const ConfigKey&) const = default;
+};
+
+// Configurations in table order: per build, the reference, then culling-major, policy-minor.
+std::vector<ConfigKey> config_order(const ExperimentOptions& opt) {
+  std::vector<ConfigKey> keys;
+  for (BvhBuild b : opt.builds) {
+    keys.push_back({build_name(b), "none", "-"});
+    for (Culling c : opt.cullings) {
+      if (c == Culling::None) continue;
+      for (ConePolicy p : opt.policies)
+        keys.push_back({build_name(b), culling_name(c), policy_name(p)});
+    }
+  }
+  return keys;
+}
+
+struct SceneData {
+  const Sequence* seq = nullptr;
+  std::map<ConfigKey, Agg> agg;
+  std::vector<StepRow> rows;
+  std::vector<SpreadRow> spread;
+};
+
+SceneData collect(const Sequence& seq, const ExperimentOptions& opt) {
+  SceneData d;
+  d.seq = &seq;
+  const auto order = config_order(opt);
+  for (BvhBuild b : opt.builds) {
+    const fs::path dir = opt.out / "runs" / seq.name;
+    const fs::path file = dir / (build_name(b) + ".csv");
+    const fs::path sfile = dir / (build_name(b) + ".spread.csv");
+    if (fs::exists(file)) {
+      for (auto& r : read_step_rows(file)) {
+        if (r.step >= seq.steps()) continue;
+        if (std::find(order.begin(), order.end(), ConfigKey{r.build, r.culling, r.policy}) ==
+            order.end()) {
+          continue;  // a configuration not asked for this time
+        }
+        d.rows.push_back(std::move(r));
+      }
+    }
+    if (fs::exists(sfile)) {
+      for (auto& r : read_spread_rows(sfile)) {
+        if (r.step < seq.steps()) d.spread.push_back(std::move(r));
+      }
+    }
+  }
+  // The reference's pair counts per (build, step), for the misses table.
+  std::map<std::pair<std::string, int>, const StepRow*> ref;
+  for (const auto& r : d.rows) {
+    if (r.culling == "none") ref[{r.build, r.step}] = &r;
+  }
+  for (const auto& r : d.rows) {
+    Agg& a = d.agg[{r.build, r.culling, r.policy}];
+    ++a.calls;
+    a.pairs.push_back(r.triangle_pairs);
+    a.vf.push_back(r.vf_tests);
+    a.ee.push_back(r.ee_tests);
+    a.culled.push_back(r.nodes_culled);
+    a.refit.push_back(r.ms_refit);
+    a.cd.push_back(r.ms_cd());
+    a.total.push_back(r.ms_total());
+    a.missed_vf += r.missed_vf;
+    a.missed_ee += r.missed_ee;
+    a.extra += r.extra_vf + r.extra_ee;
+    a.steps_missing += (r.missed_vf + r.missed_ee > 0) ? 1 : 0;
+    if (const auto it = ref.find({r.build, r.step}); it != ref.end()) {
+      a.ref_vf += it->second->vf_collisions;
+      a.ref_ee += it->second->ee_collisions;
+    }
+  }
+  return d;
+}
+
+std::string scene_heading(const SceneData& d) {
+  return fmt::format("## {} ({} triangles, {} CD calls)\n\nFrames: {}\n\n", d.seq->name,
+                     grouped(double(d.seq->faces.size())), d.seq->steps(), d.seq->source);
+}
+
+std::string table1(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
+  std::string s =
+      "# Table 1: average triangle pair tests per CD call\n\n"
+      "A triangle pair test = a non-adjacent triangle pair reaching the narrow phase (its VF/EE "
+      "elementary tests follow). Averages over every CD call (consecutive frame pair) of the "
+      "scene; *vs PROVOT* = 1 - X / PROVOT under the same build and culling rule (positive = "
+      "fewer tests); *vs none* = share of the unculled traversal's pairs removed by cone "
+      "culling.\n\n"
+      "### The paper (Han et al. 2021, Table 1; cone rule)\n\n"
+      "| scene | triangles | PROVOT | PROPOSED | reduction |\n|---|---|---|---|---|\n";
+  double red_sum = 0;
+  for (const auto& p : kPaper) {
+    const double r = reduction(p.pairs_proposed, p.pairs_provot);
+    red_sum += r;
+    s += fmt::format("| {} | {} | {} | {} | {} |\n", p.scene, grouped(p.triangles),
+                     grouped(p.pairs_provot, 2), grouped(p.pairs_proposed, 2), pct(r));
+  }
+  s += fmt::format("| average | | | | {} (the paper states 25.45%) |\n\n",
+                   pct(red_sum / std::size(kPaper)));
+
+  s += "### Ours: reduction of triangle pair tests vs PROVOT, per rule (paper: +25.5% on "
+       "average)\n\n| scene | triangles | build |";
+  std::vector<std::pair<Culling, ConePolicy>> cols;
+  for (Culling c : opt.cullings) {
+    if (c == Culling::None) continue;
+    for (ConePolicy p : opt.policies) {
+      if (p == ConePolicy::Provot) continue;
+      cols.emplace_back(c, p);
+      s += fmt::format(" {} {} |", culling_name(c), policy_name(p));
+    }
+  }
+  s += "\n|---|---|---|";
+  for (std::size_t i = 0; i < cols.size(); ++i)
+    s += "---|";
+  s += "\n";
+  for (const auto& d : data) {
+    for (BvhBuild b : opt.builds) {
+      s += fmt::format("| {} | {} | {} |", d.seq->name, grouped(double(d.seq->faces.size())),
+                       build_name(b));
+      for (const auto& [c, p] : cols) {
+        const auto it = d.agg.find({build_name(b), culling_name(c), policy_name(p)});
+        const auto base = d.agg.find({build_name(b), culling_name(c), "PROVOT"});
+        s += " " +
+             (it != d.agg.end() && base != d.agg.end()
+                  ? pct(reduction(mean(it->second.pairs), mean(base->second.pairs)))
+                  : std::string("-")) +
+             " |";
+      }
+      s += "\n";
+    }
+  }
+  s += "\n";
+  for (const auto& d : data) {
+    s += scene_heading(d);
+    s += "| build | culling | policy | calls | triangle pairs | vs PROVOT | vs none | VF tests | "
+         "EE tests | nodes culled |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& k : config_order(opt)) {
+      const auto it = d.agg.find(k);
+      if (it == d.agg.end()) continue;
+      const Agg& a = it->second;
+      const auto base = d.agg.find({k.build, k.culling, "PROVOT"});
+      const auto none = d.agg.find({k.build, "none", "-"});
+      const double m = mean(a.pairs);
+      s += fmt::format(
+          "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", k.build, k.culling, k.policy,
+          a.calls, grouped(m, 1),
+          base != d.agg.end() && k.culling != "none" ? pct(reduction(m, mean(base->second.pairs)))
+                                                     : "-",
+          none != d.agg.end() && k.culling != "none" ? pct(reduction(m, mean(none->second.pairs)))
+                                                     : "-",
+          grouped(mean(a.vf), 1), grouped(mean(a.ee), 1), grouped(mean(a.culled), 1));
+    }
+    s += "\n";
+  }
+  return s;
+}
+
+std::string table2(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
+  std::string s =
+      "# Table 2: average time per CD call (ms)\n\n"
+      "refit = swept boxes + normal cones (the paper's \"BVH construction\"; ours refits a tree "
+      "built once), CD = self traversal + narrow phase (VF/EE tests with the NP filter and the "
+      "CCD kernels), total = refit + CD; *vs PROVOT* = 1 - total / PROVOT's total under the "
+      "same build and culling rule. Means as in the paper, plus the median of the total. All "
+      "configurations of a step run back to back on the same frames, so machine noise is "
+      "shared; compare within a scene.\n\n"
+      "### The paper (Han et al. 2021, Table 2; Intel Core i9-9900)\n\n"
+      "| scene | BVH PROVOT | BVH PROPOSED | CD PROVOT | CD PROPOSED | total PROVOT | total "
+      "PROPOSED | reduction |\n|---|---|---|---|---|---|---|---|\n";
+  double red_sum = 0;
+  for (const auto& p : kPaper) {
+    const double r = reduction(p.total_proposed, p.total_provot);
+    red_sum += r;
+    s += fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} |\n", p.scene,
+                     p.bvh_provot, p.bvh_proposed, p.cd_provot, p.cd_proposed, p.total_provot,
+                     p.total_proposed, pct(r));
+  }
+  s += fmt::format("| average | | | | | | | {} (the paper states 18.24%) |\n\n",
+                   pct(red_sum / std::size(kPaper)));
+  for (const auto& d : data) {
+    s += scene_heading(d);
+    s += "| build | culling | policy | calls | refit | CD | total | median total | vs PROVOT "
+         "|\n|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& k : config_order(opt)) {
+      const auto it = d.agg.find(k);
+      if (it == d.agg.end()) continue;
+      const Agg& a = it->second;
+      const auto base = d.agg.find({k.build, k.culling, "PROVOT"});
+      s += fmt::format("| {} | {} | {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} |\n", k.build,
+                       k.culling, k.policy, a.calls, mean(a.refit), mean(a.cd), mean(a.total),
+                       median(a.total),
+                       base != d.agg.end() && k.culling != "none"
+                           ? pct(reduction(mean(a.total), mean(base->second.total)))
+                           : "-");
+    }
+    s += "\n";
+  }
+  return s;
+}
+
+std::string misses(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
+  std::string s =
+      "# Missed collisions vs culling `none`\n\n"
+      "Per configuration, summed over the CD calls: the unculled reference's collisions (VF and "
+      "EE pairs, same build, same step) and how many of them the configuration did not report "
+      "(exact pair sets, (vertex, face) and (edge, edge)). *extra* counts pairs reported that "
+      "the reference did not (culling only removes work, so it must be 0). `sound` must miss "
+      "nothing.\n\n";
+  int sound_fail = 0, extra_fail = 0;
+  for (const auto& d : data) {
+    s += scene_heading(d);
+    s += "| build | culling | policy | calls | reference VF | reference EE | missed VF | missed "
+         "EE | calls with misses | extra | |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& k : config_order(opt)) {
+      const auto it = d.agg.find(k);
+      if (it == d.agg.end() || k.culling == "none") continue;
+      const Agg& a = it->second;
+      std::string verdict;
+      if (a.extra > 0) {
+        verdict = "**extra pairs: bug**";
+        ++extra_fail;
+      }
+      if (k.culling == "sound") {
+        const bool ok = a.missed_vf + a.missed_ee == 0;
+        verdict += ok ? "sound: 0 missed" : "**FAIL: sound missed collisions**";
+        sound_fail += ok ? 0 : 1;
+      } else if (a.missed_vf + a.missed_ee > 0) {
+        verdict += "unsound here";
+      }
+      s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", k.build,
+                       k.culling, k.policy, a.calls, grouped(a.ref_vf), grouped(a.ref_ee),
+                       grouped(a.missed_vf), grouped(a.missed_ee), a.steps_missing,
+                       grouped(a.extra), verdict);
+    }
+    s += "\n";
+  }
+  s += fmt::format("Summary: {} sound configuration(s) with misses, {} with extra pairs.\n",
+                   sound_fail, extra_fail);
+  return s;
+}
+
+std::string spread_table(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
+  std::string s =
+      "# Spread angles (degrees)\n\n"
+      "*node*: the tracked node of fig5 (mid depth, non-saturated PROVOT cone at the first "
+      "step; the median such angle), mean over the steps where it was computed. *vs OPTIMAL*: "
+      "on the steps with OPTIMAL cones (every `--optimal-every` steps), the mean half-angle over "
+      "the internal nodes whose OPTIMAL cone is not saturated, divided by OPTIMAL's mean there. "
+      "*internal mean*: over all internal nodes, saturated cones counted as 90.\n\n";
+  for (const auto& d : data) {
+    s += scene_heading(d);
+    s += "| build | policy | node (depth) | node angle | internal mean | saturated share | "
+         "mean on OPTIMAL domain | vs OPTIMAL | refit ms | steps |\n"
+         "|---|---|---|---|---|---|---|---|---|---|\n";
+    for (BvhBuild b : opt.builds) {
+      std::vector<std::string> policies;
+      for (ConePolicy p : opt.policies)
+        policies.push_back(policy_name(p));
+      policies.push_back("OPTIMAL");
+      // OPTIMAL's domain mean per step, to pair each policy with it step by step.
+      std::map<int, double> opt_mean;
+      for (const auto& r : d.spread) {
+        if (r.build == build_name(b) && r.policy == "OPTIMAL") opt_mean[r.step] = r.opt_domain_mean;
+      }
+      for (const auto& p : policies) {
+        std::vector<double> node, internal, sat, dom, dom_opt, ms;
+        int id = -1, depth = -1;
+        for (const auto& r : d.spread) {
+          if (r.build != build_name(b) || r.policy != p) continue;
+          id = r.node;
+          depth = r.node_depth;
+          node.push_back(r.node_angle);
+          internal.push_back(r.internal_mean);
+          sat.push_back(r.saturated_share);
+          ms.push_back(r.ms_refit);
+          if (const auto it = opt_mean.find(r.step);
+              it != opt_mean.end() && !std::isnan(r.opt_domain_mean)) {
+            dom.push_back(r.opt_domain_mean);
+            dom_opt.push_back(it->second);
+          }
+        }
+        if (node.empty()) continue;
+        s += fmt::format(
+            "| {} | {} | {} ({}) | {:.2f} | {:.2f} | {:.1f}% | {} | {} | {:.1f} | {} "
+            "|\n",
+            build_name(b), p, id, depth, mean(node), mean(internal), 100 * mean(sat),
+            dom.empty() ? "-" : fmt::format("{:.2f}", mean(dom)),
+            dom.empty() ? "-" : fmt::format("{:.3f}", mean(dom) / mean(dom_opt)), mean(ms),
+            node.size());
+      }
+    }
+    s += "\n";
+  }
+  return s;
+}
+
+}  // namespace
+
+void write_reports(const std::vector<Sequence>& scenes, const ExperimentOptions& opt) {
+  std::vector<SceneData> data;
+  data.reserve(scenes.size());
+  for (const auto& seq : scenes)
+    data.push_back(collect(seq, opt));
+  std::vector<StepRow> rows;
+  std::vector<SpreadRow> spread;
+  for (const auto& d : data) {
+    rows.insert(rows.end(), d.rows.begin(), d.rows.end());
+    spread.insert(spread.end(), d.spread.begin(), d.spread.end());
+  }
+  detail::write_text_atomic(opt.out / "steps.csv", detail::step_rows_csv(rows));
+  detail::write_text_atomic(opt.out / "spread.csv", detail::spread_rows_csv(spread));
+  detail::write_text_atomic(opt.out / "table1.md", table1(data, opt));
+  detail::write_text_atomic(opt.out / "table2.md", table2(data, opt));
+  detail::write_text_atomic(opt.out / "misses.md", misses(data, opt));
+  detail::write_text_atomic(opt.out / "spread.md", spread_table(data, opt));
+}
+
+std::string run_plots(const fs::path& out, const fs::path& script, const std::string& python) {
+  if (!fs::exists(script)) return fmt::format("plot script {} not found", script.string());
+  // Quoting: paths come from the command line; single quotes with embedded ones escaped.
+  auto quote = [](const std::string& s) {
+    std::string q = "'";
+    for (char c : s)
+      q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+  };
+  const std::string cmd =
+      fmt::format("{} {} {} 2>&1", quote(python), quote(script.string()), quote(out.string()));
+  const int rc = std::system(cmd.c_str());
+  if (rc != 0) {
+    return fmt::format("'{}' failed (exit status {}); is python3-matplotlib installed for {}?", cmd,
+                       rc, python);
+  }
+  return {};
+}
+
+}  // namespace clothcd::experiment

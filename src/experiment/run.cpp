@@ -1,0 +1,280 @@
+// Runs every configuration over a sequence: one detector per BVH build (the build is fixed at
+// construction; policy and culling change per call), the unculled reference first at every step,
+// then each (policy, culling), all on the same two frames, so timing noise is shared step by step.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <tuple>
+
+#include "clothcd/bvh/bvh.hpp"
+#include "clothcd/core/error.hpp"
+#include "clothcd/experiment/experiment.hpp"
+#include "records.hpp"
+
+namespace clothcd::experiment {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+std::vector<Eigen::Vector3d> points(const Positions& p) {
+  std::vector<Eigen::Vector3d> out(static_cast<std::size_t>(p.rows()));
+  for (Eigen::Index i = 0; i < p.rows(); ++i)
+    out[static_cast<std::size_t>(i)] = p.row(i).transpose();
+  return out;
+}
+
+// |a \ b| for sorted collision lists compared by their feature ids only (not the toi).
+template <class T, class Key>
+std::size_t count_missing(const std::vector<T>& a, const std::vector<T>& b, Key key) {
+  std::size_t n = 0;
+  auto j = b.begin();
+  for (const T& x : a) {
+    while (j != b.end() && key(*j) < key(x))
+      ++j;
+    if (j == b.end() || key(x) < key(*j)) ++n;
+  }
+  return n;
+}
+
+auto vf_key = [](const VertexFaceCollision& c) { return std::pair(c.vertex, c.face); };
+auto ee_key = [](const EdgeEdgeCollision& c) { return std::pair(c.edge_a, c.edge_b); };
+
+StepRow make_row(const Sequence& seq, BvhBuild build, int step, Culling c, const std::string& p,
+                 const DetectResult& r, const DetectResult& ref) {
+  const DetectStats& s = r.stats;
+  StepRow row;
+  row.scene = seq.name;
+  row.build = build_name(build);
+  row.culling = culling_name(c);
+  row.policy = p;
+  row.step = step;
+  row.faces = static_cast<double>(seq.faces.size());
+  row.triangle_pairs = double(s.triangle_pairs);
+  row.vf_tests = double(s.vf_tests);
+  row.ee_tests = double(s.ee_tests);
+  row.vf_np_culled = double(s.vf_np_culled);
+  row.ee_np_culled = double(s.ee_np_culled);
+  row.box_tests = double(s.box_tests);
+  row.cone_tests = double(s.cone_tests);
+  row.nodes_culled = double(s.nodes_culled);
+  row.contour_tests = double(s.contour_tests);
+  row.contour_fails = double(s.contour_fails);
+  row.vf_collisions = double(r.vf.size());
+  row.ee_collisions = double(r.ee.size());
+  row.missed_vf = double(count_missing(ref.vf, r.vf, vf_key));
+  row.missed_ee = double(count_missing(ref.ee, r.ee, ee_key));
+  row.extra_vf = double(count_missing(r.vf, ref.vf, vf_key));
+  row.extra_ee = double(count_missing(r.ee, ref.ee, ee_key));
+  row.ms_refit = 1e3 * s.time_refit;
+  row.ms_traverse = 1e3 * s.time_traverse;
+  row.ms_narrow = 1e3 * s.time_narrow;
+  return row;
+}
+
+// The tracked node of Figure 5: at mid depth (or the first deeper level that has one), a node
+// whose PROVOT cone at the first step is neither skinny nor saturated; of those, the one with the
+// median angle, so the choice favours no policy.
+std::pair<int, int> pick_node(const Bvh& bvh) {
+  const auto& cones = bvh.cones();
+  const auto& nodes = bvh.nodes();
+  const auto& lv = bvh.level_offsets();
+  for (int d = std::max(1, bvh.depth() / 2); d < bvh.depth(); ++d) {
+    std::vector<std::pair<double, int>> cand;
+    for (int i = lv[d]; i < lv[d + 1]; ++i) {
+      if (!nodes[i].is_leaf() && !cones[i].saturated() && cones[i].half_angle > 1e-6) {
+        cand.emplace_back(cones[i].half_angle, i);
+      }
+    }
+    if (!cand.empty()) {
+      std::sort(cand.begin(), cand.end());
+      return {cand[cand.size() / 2].second, d};
+    }
+  }
+  return {0, 0};  // everything saturated: track the root
+}
+
+int depth_of(const Bvh& bvh, int node) {
+  const auto& lv = bvh.level_offsets();
+  for (int d = 0; d + 1 < static_cast<int>(lv.size()); ++d) {
+    if (node < lv[d + 1]) return d;
+  }
+  return -1;
+}
+
+std::vector<SpreadRow> spreads(const Sequence& seq, BvhBuild build, int step, Bvh& bvh,
+                               const std::vector<ConePolicy>& policies, bool optimal,
+                               const std::vector<Eigen::Vector3d>& v0,
+                               const std::vector<Eigen::Vector3d>& v1, int node) {
+  std::vector<ConePolicy> all = policies;
+  if (optimal) all.insert(all.begin(), ConePolicy::Optimal);  // first: its domain is needed
+  std::vector<char> domain;
+  std::vector<SpreadRow> out;
+  for (ConePolicy p : all) {
+    RefitOptions ro;
+    ro.policy = p;
+    const auto t = std::chrono::steady_clock::now();
+    bvh.refit(v0, v1, ro);
+    const double ms =
+        1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+    const auto& cones = bvh.cones();
+    const auto& nodes = bvh.nodes();
+    if (p == ConePolicy::Optimal) {
+      domain.assign(nodes.size(), 0);
+      for (std::size_t i = 0; i < nodes.size(); ++i)
+        domain[i] = !nodes[i].is_leaf() && !cones[i].saturated();
+    }
+    SpreadRow r;
+    r.scene = seq.name;
+    r.build = build_name(build);
+    r.policy = policy_name(p);
+    r.step = step;
+    r.node = node;
+    r.node_depth = depth_of(bvh, node);
+    r.node_angle = kDeg * cones[node].half_angle;
+    double sum = 0, dsum = 0;
+    int internal = 0, saturated = 0, dn = 0;
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      if (nodes[i].is_leaf()) continue;
+      ++internal;
+      const double a = cones[i].saturated() ? std::numbers::pi / 2 : cones[i].half_angle;
+      sum += a;
+      saturated += cones[i].saturated() ? 1 : 0;
+      if (!domain.empty() && domain[i] != 0) {
+        dsum += a;
+        ++dn;
+      }
+    }
+    r.internal_mean = internal > 0 ? kDeg * sum / internal : std::nan("");
+    r.saturated_share = internal > 0 ? double(saturated) / internal : 0.0;
+    r.opt_domain_mean = dn > 0 ? kDeg * dsum / dn : std::nan("");
+    r.opt_domain_nodes = dn;
+    r.ms_refit = ms;
+    out.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace
+
+void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
+                  const std::function<void(const Progress&)>& on_progress, int done_before,
+                  int total) {
+  for (ConePolicy p : opt.policies) {
+    if (p == ConePolicy::Optimal) {
+      throw InputError(
+          "OPTIMAL is measured for the spread angles only (--optimal-every), not as "
+          "a detection policy: its refit takes seconds per step");
+    }
+  }
+  const fs::path dir = opt.out / "runs" / seq.name;
+  fs::create_directories(dir);
+  int done = done_before;
+  if (total <= 0) total = seq.steps() * static_cast<int>(opt.builds.size());
+  for (BvhBuild build : opt.builds) {
+    const fs::path file = dir / (build_name(build) + ".csv");
+    const fs::path sfile = dir / (build_name(build) + ".spread.csv");
+    std::vector<StepRow> rows = fs::exists(file) ? read_step_rows(file) : std::vector<StepRow>{};
+    std::vector<SpreadRow> srows =
+        fs::exists(sfile) ? read_spread_rows(sfile) : std::vector<SpreadRow>{};
+    std::set<std::tuple<int, std::string, std::string>> have;
+    for (const auto& r : rows)
+      have.emplace(r.step, r.culling, r.policy);
+    std::set<std::pair<int, std::string>> have_spread;
+    int node = srows.empty() ? -1 : srows.front().node;
+    for (const auto& r : srows)
+      have_spread.emplace(r.step, r.policy);
+
+    std::optional<SelfDetector> det;
+    std::optional<Bvh> bvh;
+    std::vector<Eigen::Vector3d> ref_points;
+    auto ensure = [&] {
+      if (det) return;
+      DetectOptions o;
+      o.build = build;
+      det.emplace(seq.faces, seq.num_vertices, seq.frames[0], o);
+      ref_points = points(seq.frames[0]);
+      bvh.emplace(det->topology(), ref_points, build);
+      // The spread angles must describe the detector's tree: same build, same reference.
+      if (bvh->prim_ids() != det->bvh().prim_ids() ||
+          bvh->nodes().size() != det->bvh().nodes().size()) {
+        throw std::logic_error("experiment: the spread-angle BVH differs from the detector's");
+      }
+      if (node < 0) {
+        RefitOptions ro;
+        ro.policy = ConePolicy::Provot;
+        const auto p0 = points(seq.frames[0]), p1 = points(seq.frames[1]);
+        bvh->refit(p0, p1, ro);
+        node = pick_node(*bvh).first;
+      }
+    };
+
+    for (int step = 0; step < seq.steps(); ++step) {
+      std::vector<std::pair<ConePolicy, Culling>> todo;
+      for (ConePolicy p : opt.policies) {
+        for (Culling c : opt.cullings) {
+          if (c == Culling::None) continue;
+          if (!have.contains({step, culling_name(c), policy_name(p)})) todo.emplace_back(p, c);
+        }
+      }
+      const bool need_none = !have.contains({step, "none", "-"});
+      const bool optimal_step = opt.optimal_every > 0 && step % opt.optimal_every == 0;
+      bool need_spread = optimal_step && !have_spread.contains({step, "OPTIMAL"});
+      for (ConePolicy p : opt.policies)
+        need_spread = need_spread || !have_spread.contains({step, policy_name(p)});
+      const std::string what =
+          fmt::format("{} {} step {}/{}", seq.name, build_name(build), step + 1, seq.steps());
+      if (todo.empty() && !need_none && !need_spread) {
+        ++done;
+        if (on_progress) on_progress({done, total, false, what});
+        continue;
+      }
+      ensure();
+      const Positions& x0 = seq.frames[static_cast<std::size_t>(step)];
+      const Positions& x1 = seq.frames[static_cast<std::size_t>(step) + 1];
+      if (need_none || !todo.empty()) {
+        DetectOptions o;
+        o.build = build;
+        o.culling = Culling::None;
+        det->set_options(o);
+        const DetectResult ref = det->detect(x0, x1);
+        if (need_none) {
+          rows.push_back(make_row(seq, build, step, Culling::None, "-", ref, ref));
+          have.emplace(step, "none", "-");
+        }
+        for (const auto& [p, c] : todo) {
+          o.policy = p;
+          o.culling = c;
+          det->set_options(o);
+          const DetectResult r = det->detect(x0, x1);
+          rows.push_back(make_row(seq, build, step, c, policy_name(p), r, ref));
+          have.emplace(step, culling_name(c), policy_name(p));
+        }
+      }
+      if (need_spread) {
+        std::erase_if(srows, [&](const SpreadRow& r) { return r.step == step; });
+        const auto p0 = points(x0), p1 = points(x1);
+        for (auto& r : spreads(seq, build, step, *bvh, opt.policies, optimal_step, p0, p1, node)) {
+          have_spread.emplace(step, r.policy);
+          srows.push_back(std::move(r));
+        }
+      }
+      std::stable_sort(rows.begin(), rows.end(),
+                       [](const StepRow& a, const StepRow& b) { return a.step < b.step; });
+      std::stable_sort(srows.begin(), srows.end(),
+                       [](const SpreadRow& a, const SpreadRow& b) { return a.step < b.step; });
+      // Spread first: the step counts as done once its detection rows are on disk.
+      detail::write_text_atomic(sfile, detail::spread_rows_csv(srows));
+      detail::write_text_atomic(file, detail::step_rows_csv(rows));
+      ++done;
+      if (on_progress) on_progress({done, total, true, what});
+    }
+  }
+}
+
+}  // namespace clothcd::experiment

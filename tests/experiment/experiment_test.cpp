@@ -1,0 +1,247 @@
+// The experiment harness on a tiny procedural sequence: one row per step x configuration, the
+// reference equal to the brute-force oracle, `sound` equal to the reference, resume, tables, plots.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <tuple>
+
+#include "clothcd/core/error.hpp"
+#include "clothcd/detect/oracle.hpp"
+#include "clothcd/experiment/experiment.hpp"
+#include "clothcd/mesh/io.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace clothcd;
+using namespace clothcd::experiment;
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() /
+                     ("clothcd_experiment_test_" + name + "_" +
+                      std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Every markdown table row has as many cells as its table's header; returns the rows seen.
+int check_markdown_tables(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  int header_cells = -1, rows = 0;
+  auto cells = [](const std::string& l) {
+    return static_cast<int>(std::count(l.begin(), l.end(), '|'));
+  };
+  while (std::getline(in, line)) {
+    if (line.starts_with("|")) {
+      if (header_cells < 0) {
+        header_cells = cells(line);
+      } else {
+        EXPECT_EQ(cells(line), header_cells) << line;
+        ++rows;
+      }
+    } else {
+      header_cells = -1;
+    }
+  }
+  return rows;
+}
+
+TEST(Experiment, FoldingSheetHasSelfCollisions) {
+  const Sequence seq = folding_sheet(8, 4);
+  EXPECT_EQ(seq.steps(), 4);
+  EXPECT_EQ(seq.faces.size(), 128u);
+  const Topology topo(seq.faces, seq.num_vertices);
+  std::size_t total = 0;
+  for (int s = 0; s < seq.steps(); ++s) {
+    const DetectResult r = brute_force_detect(topo, seq.frames[s], seq.frames[s + 1]);
+    total += r.vf.size() + r.ee.size();
+  }
+  EXPECT_GT(total, 0u) << "the test sequence must exercise the miss accounting";
+}
+
+TEST(Experiment, RowsPerStepAndConfigurationSoundEqualsReference) {
+  const Sequence seq = folding_sheet(8, 4);
+  ExperimentOptions opt;
+  opt.out = temp_dir("rows");
+  opt.optimal_every = 2;
+  int ran = 0, last_done = 0;
+  run_sequence(seq, opt, [&](const Progress& p) {
+    ran += p.ran ? 1 : 0;
+    last_done = p.done;
+  });
+  EXPECT_EQ(ran, seq.steps() * 2);
+  EXPECT_EQ(last_done, seq.steps() * 2);
+
+  std::vector<StepRow> rows;
+  for (const char* b : {"spatial", "patch"}) {
+    auto r = read_step_rows(opt.out / "runs" / seq.name / (std::string(b) + ".csv"));
+    rows.insert(rows.end(), r.begin(), r.end());
+  }
+  // 3 policies x 3 cullings + the reference, per build and step, each exactly once.
+  ASSERT_EQ(rows.size(), std::size_t(seq.steps()) * 2 * 10);
+  std::set<std::tuple<int, std::string, std::string, std::string>> keys;
+  for (const auto& r : rows)
+    keys.emplace(r.step, r.build, r.culling, r.policy);
+  EXPECT_EQ(keys.size(), rows.size());
+
+  // The reference is the oracle's pair count; sound reports exactly the reference's pairs.
+  const Topology topo(seq.faces, seq.num_vertices);
+  std::map<std::pair<std::string, int>, const StepRow*> ref;
+  for (const auto& r : rows) {
+    if (r.culling == "none") ref[{r.build, r.step}] = &r;
+  }
+  ASSERT_EQ(ref.size(), std::size_t(seq.steps()) * 2);
+  for (const auto& [key, r] : ref) {
+    const DetectResult o =
+        brute_force_detect(topo, seq.frames[key.second], seq.frames[key.second + 1]);
+    EXPECT_EQ(r->vf_collisions, double(o.vf.size())) << key.first << " step " << key.second;
+    EXPECT_EQ(r->ee_collisions, double(o.ee.size())) << key.first << " step " << key.second;
+  }
+  for (const auto& r : rows) {
+    const StepRow& n = *ref.at({r.build, r.step});
+    EXPECT_EQ(r.extra_vf + r.extra_ee, 0) << r.build << " " << r.culling << " " << r.policy;
+    EXPECT_EQ(r.vf_collisions + r.missed_vf, n.vf_collisions);
+    EXPECT_EQ(r.ee_collisions + r.missed_ee, n.ee_collisions);
+    EXPECT_LE(r.triangle_pairs, n.triangle_pairs);
+    if (r.culling == "sound") {
+      EXPECT_EQ(r.missed_vf + r.missed_ee, 0) << r.build << " " << r.policy << " step " << r.step;
+    }
+  }
+
+  // Spread angles: every policy every step, OPTIMAL on steps 0 and 2, one tracked node; the
+  // tight merges never exceed PROVOT's, and the two merge policies never beat OPTIMAL on its
+  // domain (OPTIMAL bounds the same control directions; EXACT's exact caps may be tighter).
+  const auto spread = read_spread_rows(opt.out / "runs" / seq.name / "spatial.spread.csv");
+  ASSERT_EQ(spread.size(), std::size_t(seq.steps()) * 3 + 2);
+  std::map<std::pair<int, std::string>, SpreadRow> sp;
+  for (const auto& r : spread) {
+    EXPECT_EQ(r.node, spread.front().node);
+    sp[{r.step, r.policy}] = r;
+  }
+  for (int s = 0; s < seq.steps(); ++s) {
+    EXPECT_LE(sp.at({s, "PROPOSED"}).internal_mean, sp.at({s, "PROVOT"}).internal_mean + 1e-9);
+    if (s % 2 == 0) {
+      const double o = sp.at({s, "OPTIMAL"}).opt_domain_mean;
+      for (const char* p : {"PROVOT", "PROPOSED"})
+        EXPECT_GE(sp.at({s, p}).opt_domain_mean, o - 1e-6) << p << " step " << s;
+    }
+  }
+
+  // A rerun finds everything done and rewrites nothing.
+  const std::string before = slurp(opt.out / "runs" / seq.name / "spatial.csv");
+  ran = 0;
+  run_sequence(seq, opt, [&](const Progress& p) { ran += p.ran ? 1 : 0; });
+  EXPECT_EQ(ran, 0);
+  EXPECT_EQ(slurp(opt.out / "runs" / seq.name / "spatial.csv"), before);
+
+  // Tables parse (consistent markdown rows) and carry every configuration.
+  write_reports({seq}, opt);
+  const std::string t1 = slurp(opt.out / "table1.md"), t2 = slurp(opt.out / "table2.md"),
+                    mi = slurp(opt.out / "misses.md");
+  EXPECT_GE(check_markdown_tables(t1), 20);
+  EXPECT_GE(check_markdown_tables(t2), 20);
+  EXPECT_GE(check_markdown_tables(mi), 18);
+  EXPECT_GE(check_markdown_tables(slurp(opt.out / "spread.md")), 8);
+  EXPECT_NE(t1.find("| spatial | gated | EXACT | 4 |"), std::string::npos);
+  EXPECT_NE(t2.find("| patch | sound | PROVOT | 4 |"), std::string::npos);
+  EXPECT_NE(mi.find("Summary: 0 sound configuration(s) with misses, 0 with extra pairs."),
+            std::string::npos);
+  EXPECT_EQ(read_step_rows(opt.out / "steps.csv").size(), rows.size());
+  fs::remove_all(opt.out);
+}
+
+TEST(Experiment, ResumeRunsOnlyMissingConfigurations) {
+  const Sequence seq = folding_sheet(6, 3);
+  ExperimentOptions opt;
+  opt.out = temp_dir("resume");
+  opt.builds = {BvhBuild::Patch};
+  opt.policies = {ConePolicy::Provot};
+  opt.optimal_every = 0;
+  run_sequence(seq, opt);
+  const auto first = read_step_rows(opt.out / "runs" / seq.name / "patch.csv");
+  EXPECT_EQ(first.size(), std::size_t(seq.steps()) * 4);
+  opt.policies = {ConePolicy::Provot, ConePolicy::Exact};
+  run_sequence(seq, opt);
+  const auto second = read_step_rows(opt.out / "runs" / seq.name / "patch.csv");
+  EXPECT_EQ(second.size(), std::size_t(seq.steps()) * 7);
+  // The rows of the first run are kept as they were (not recomputed).
+  for (const auto& r : first) {
+    const auto it = std::find_if(second.begin(), second.end(), [&](const StepRow& s) {
+      return s.step == r.step && s.culling == r.culling && s.policy == r.policy;
+    });
+    ASSERT_NE(it, second.end());
+    EXPECT_EQ(it->ms_narrow, r.ms_narrow);
+  }
+  EXPECT_THROW(
+      {
+        opt.policies = {ConePolicy::Optimal};
+        run_sequence(seq, opt);
+      },
+      InputError);
+  fs::remove_all(opt.out);
+}
+
+TEST(Experiment, LoadsFrameFolders) {
+  const Sequence seq = folding_sheet(4, 2);
+  const fs::path dir = temp_dir("frames");
+  for (int k = 0; k <= seq.steps(); ++k) {
+    TriangleMesh m;
+    m.faces = seq.faces;
+    for (Eigen::Index i = 0; i < seq.frames[k].rows(); ++i)
+      m.vertices.push_back(seq.frames[k].row(i).transpose());
+    // Numbered at the end, out of lexicographic order (9 < 10).
+    write_obj(dir / ("f" + std::to_string(9 + k) + ".obj"), m);
+  }
+  const Sequence back = load_frame_folder(dir);
+  ASSERT_EQ(back.steps(), seq.steps());
+  for (int k = 0; k <= seq.steps(); ++k)
+    EXPECT_EQ(back.frames[k], seq.frames[k]) << k;
+  EXPECT_EQ(load_frame_folder(dir, 2).steps(), 1);
+  fs::remove(dir / "f10.obj");
+  TriangleMesh other;
+  other.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  other.faces = {{0, 1, 2}};
+  write_obj(dir / "f10.obj", other);
+  EXPECT_THROW((void)load_frame_folder(dir), InputError);
+  EXPECT_THROW((void)load_frame_folder(dir / "nothing"), InputError);
+  fs::remove_all(dir);
+}
+
+TEST(Experiment, PlotScript) {
+  if (!fs::exists("/usr/bin/python3") ||
+      std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "/usr/bin/python3 with matplotlib not found (apt-get install "
+                    "python3-matplotlib)";
+  }
+  const Sequence seq = folding_sheet(6, 3);
+  ExperimentOptions opt;
+  opt.out = temp_dir("plots");
+  opt.optimal_every = 1;
+  run_sequence(seq, opt);
+  write_reports({seq}, opt);
+  EXPECT_EQ(run_plots(opt.out, CLOTHCD_PLOT_SCRIPT), "");
+  for (const char* f : {"fig5.png", "fig6.png"}) {
+    ASSERT_TRUE(fs::exists(opt.out / f)) << f;
+    EXPECT_GT(fs::file_size(opt.out / f), 10000u) << f;
+  }
+  EXPECT_NE(run_plots(opt.out, opt.out / "no_such_script.py"), "");
+  fs::remove_all(opt.out);
+}
+
+}  // namespace
