@@ -65,50 +65,13 @@ bool np_culls(const BernsteinCubic& c) {
          (c.k[0] < -e && c.k[1] < -e && c.k[2] < -e && c.k[3] < -e);
 }
 
-int candidate_times(const BernsteinCubic& c, int depth, double (*ranges)[2], int cap) {
+double subdivision_error(const BernsteinCubic& c) {
   // De Casteljau halving forms averages: each value stays within the convex hull of the
   // coefficients (|.| <= K), each level adds at most one rounding of u K to three of them, and
-  // errors already present do not grow. depth <= 40 levels of 3 averages: 120 u K < 128 u K.
+  // errors already present do not grow. 40 levels of 3 averages: 120 u K < 128 u K.
   const double kmax =
       std::max({std::abs(c.k[0]), std::abs(c.k[1]), std::abs(c.k[2]), std::abs(c.k[3])});
-  const double e = c.eta + 128 * kUnitRoundoff * kmax;
-  struct Item {
-    double b[4];
-    double lo, hi;
-    int level;
-  };
-  constexpr int kStack = 64;
-  Item stack[kStack];
-  int n = 0;
-  stack[n++] = Item{{c.k[0], c.k[1], c.k[2], c.k[3]}, 0.0, 1.0, 0};
-  int count = 0;
-  while (n > 0) {
-    const Item it = stack[--n];
-    const double* b = it.b;
-    if ((b[0] > e && b[1] > e && b[2] > e && b[3] > e) ||
-        (b[0] < -e && b[1] < -e && b[2] < -e && b[3] < -e)) {
-      continue;
-    }
-    if (it.level >= depth) {
-      if (count > 0 && ranges[count - 1][1] == it.lo) {
-        ranges[count - 1][1] = it.hi;  // contiguous with the previous range: extend it
-      } else {
-        if (count == cap) return -1;
-        ranges[count][0] = it.lo;
-        ranges[count][1] = it.hi;
-        ++count;
-      }
-      continue;
-    }
-    const double b01 = (b[0] + b[1]) * 0.5, b12 = (b[1] + b[2]) * 0.5, b23 = (b[2] + b[3]) * 0.5;
-    const double b012 = (b01 + b12) * 0.5, b123 = (b12 + b23) * 0.5;
-    const double mid_val = (b012 + b123) * 0.5;
-    const double mid = (it.lo + it.hi) * 0.5;
-    // Right half first so the left (earlier) one is processed first.
-    stack[n++] = Item{{mid_val, b123, b23, b[3]}, mid, it.hi, it.level + 1};
-    stack[n++] = Item{{b[0], b01, b012, mid_val}, it.lo, mid, it.level + 1};
-  }
-  return count;
+  return c.eta + 128 * kUnitRoundoff * kmax;
 }
 
 }  // namespace clothcd::ccd_detail

@@ -18,9 +18,34 @@ BernsteinCubic coplanarity_cubic(Kind kind, const Motion& m);
 /// True when every coefficient is provably of one sign: no root in [0, 1].
 bool np_culls(const BernsteinCubic& c);
 
-/// Time ranges (in increasing order, disjoint) outside of which the exact cubic provably does
-/// not vanish, found by de Casteljau subdivision to 2^-depth. Returns the number of ranges, or
-/// -1 when there would be more than `cap` of them.
-int candidate_times(const BernsteinCubic& c, int depth, double (*ranges)[2], int cap);
+/// Bound on |computed - exact| of every Bernstein coefficient obtained from `c` by up to 40
+/// levels of de Casteljau halving (`halve`).
+double subdivision_error(const BernsteinCubic& c);
+
+/// De Casteljau halving of Bernstein coefficients on [lo, hi] into [lo, mid] and [mid, hi].
+inline void halve(const double (&b)[4], double (&left)[4], double (&right)[4]) {
+  const double b01 = (b[0] + b[1]) * 0.5, b12 = (b[1] + b[2]) * 0.5, b23 = (b[2] + b[3]) * 0.5;
+  const double b012 = (b01 + b12) * 0.5, b123 = (b12 + b23) * 0.5;
+  const double mid = (b012 + b123) * 0.5;
+  left[0] = b[0];
+  left[1] = b01;
+  left[2] = b012;
+  left[3] = mid;
+  right[0] = mid;
+  right[1] = b123;
+  right[2] = b23;
+  right[3] = b[3];
+}
+
+/// Every coefficient provably of one sign (error e): the cubic has no root on the range.
+inline bool one_sign(const double (&b)[4], double e) {
+  return (b[0] > e && b[1] > e && b[2] > e && b[3] > e) ||
+         (b[0] < -e && b[1] < -e && b[2] < -e && b[3] < -e);
+}
+
+/// The values at the two ends (b[0], b[3]) provably of opposite signs: a root on the range.
+inline bool sign_change(const double (&b)[4], double e) {
+  return (b[0] > e && b[3] < -e) || (b[0] < -e && b[3] > e);
+}
 
 }  // namespace clothcd::ccd_detail

@@ -1,7 +1,9 @@
 // The public CCD kernels: validation, rescaling, then the fast path (zero thickness) or the
 // inclusion solver. Soundness of the combination: a zero-thickness contact needs the four points
-// coplanar, i.e. a root of the exact coplanarity cubic; the fast path drops only time ranges on
-// which that cubic provably has no root and hands every other range to the inclusion solver.
+// coplanar, i.e. a root of the exact coplanarity cubic, with the contact point in the features;
+// the fast path drops only time ranges on which that cubic provably has no root or the point is
+// provably outside, certifies a hit only where both provably hold, and hands every other range to
+// the inclusion solver.
 
 #include "clothcd/ccd/queries.hpp"
 
@@ -11,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "ccd/cubic.hpp"
+#include "ccd/fast_path.hpp"
 #include "ccd/inclusion.hpp"
 #include "ccd/motion.hpp"
 
@@ -20,10 +23,6 @@ namespace {
 
 using ccd_detail::Kind;
 using ccd_detail::Motion;
-
-// Candidate time ranges are isolated to 2^-kRootDepth before the inclusion solver takes over.
-constexpr int kRootDepth = 8;
-constexpr int kMaxRanges = 8;
 
 void check_options(const CcdOptions& opt) {
   if (!(opt.thickness >= 0) || !std::isfinite(opt.thickness)) {
@@ -77,23 +76,15 @@ CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
       r.path = CcdPath::np_culled;
       return r;
     }
-    double ranges[kMaxRanges][2];
-    const int count = ccd_detail::candidate_times(cubic, kRootDepth, ranges, kMaxRanges);
-    if (count >= 0) {
-      std::uint32_t boxes = 0;
-      // In time order: the first range with a hit holds the earliest contact.
-      for (int i = 0; i < count; ++i) {
-        p.t_lo = ranges[i][0];
-        p.t_hi = ranges[i][1];
-        const auto o = ccd_detail::inclusion_solve(kind, m, p);
-        boxes += o.boxes;
-        if (o.hit) return from(o, CcdPath::fast_path, boxes);
-      }
-      CcdResult r;
-      r.path = CcdPath::fast_path;
-      r.boxes = boxes;
-      return r;
-    }
+    const ccd_detail::FastOutcome o = ccd_detail::fast_path_solve(kind, m, cubic, p);
+    CcdResult r;
+    r.hit = o.hit;
+    r.toi = o.hit ? o.toi : 1.0;
+    r.u = o.u;
+    r.v = o.v;
+    r.path = o.certified ? CcdPath::certified : CcdPath::fast_path;
+    r.boxes = o.boxes;
+    return r;
   }
   const auto o = ccd_detail::inclusion_solve(kind, m, p);
   return from(o, CcdPath::inclusion, o.boxes);

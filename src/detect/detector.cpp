@@ -51,6 +51,8 @@ struct SelfDetector::Impl {
   // Active restriction: features on active faces, and the nodes holding a face that touches one.
   bool restricted = false;
   std::vector<std::uint8_t> face_active, vertex_active, edge_active, node_active;
+  // Per-step swept boxes of the features (storage reused across steps).
+  std::vector<detail::Box> vboxes, eboxes, fboxes;
 
   Impl(std::vector<Face> faces, int nv, const Positions& ref, const DetectOptions& o)
       : topo(std::move(faces), nv), opt(o) {
@@ -130,6 +132,7 @@ struct SelfDetector::Impl {
     ctx.margin = 0.5 * opt.thickness;
     ctx.np_filter = opt.np_filter;
     ctx.ccd = CcdOptions{opt.thickness, opt.fast_path};
+    detail::precompute_boxes(ctx, vboxes, eboxes, fboxes);
     tbb::enumerable_thread_specific<NarrowBuffer> locals;
     auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
     auto kee = [&](int a, int b, NarrowBuffer& out) { ctx.kernel_ee(a, b, out.c, out.ee); };
@@ -271,6 +274,7 @@ struct SelfDetector::Impl {
     ctx.v0 = v0;
     ctx.v1 = v1;
     ctx.margin = 0.5 * h;
+    detail::precompute_boxes(ctx, vboxes, eboxes, fboxes);
     struct Buffer {
       std::vector<ProximityResult::VertexFace> vf;
       std::vector<ProximityResult::EdgeEdge> ee;

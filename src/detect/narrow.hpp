@@ -2,6 +2,8 @@
 // Feature-level tests shared by the detector and the brute-force oracle, so both put every VF and
 // EE pair through exactly the same box test, NP filter and kernel.
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -59,15 +61,27 @@ struct FeatureContext {
   double margin = 0;  // thickness / 2
   bool np_filter = true;
   CcdOptions ccd;
+  /// Optional swept boxes of every vertex, edge and face for this step (`precompute_boxes`);
+  /// empty: computed on demand.
+  std::span<const Box> vboxes, eboxes, fboxes;
 
-  [[nodiscard]] Box face_box(int f) const {
+  [[nodiscard]] Box compute_face_box(int f) const {
     const Face& t = topo->faces()[f];
     return swept_box({&v0[t[0]], &v0[t[1]], &v0[t[2]], &v1[t[0]], &v1[t[1]], &v1[t[2]]}, margin);
   }
-  [[nodiscard]] Box vertex_box(int v) const { return swept_box({&v0[v], &v1[v]}, margin); }
-  [[nodiscard]] Box edge_box(int e) const {
+  [[nodiscard]] Box compute_vertex_box(int v) const { return swept_box({&v0[v], &v1[v]}, margin); }
+  [[nodiscard]] Box compute_edge_box(int e) const {
     const Edge& d = topo->edges()[e];
     return swept_box({&v0[d[0]], &v0[d[1]], &v1[d[0]], &v1[d[1]]}, margin);
+  }
+  [[nodiscard]] Box face_box(int f) const {
+    return fboxes.empty() ? compute_face_box(f) : fboxes[f];
+  }
+  [[nodiscard]] Box vertex_box(int v) const {
+    return vboxes.empty() ? compute_vertex_box(v) : vboxes[v];
+  }
+  [[nodiscard]] Box edge_box(int e) const {
+    return eboxes.empty() ? compute_edge_box(e) : eboxes[e];
   }
 
   /// Vertex v against face f (their boxes already overlap): NP filter, then the kernel.
@@ -76,11 +90,12 @@ struct FeatureContext {
     const Face& t = topo->faces()[f];
     const VertexFaceQuery q{v0[v], v0[t[0]], v0[t[1]], v0[t[2]],
                             v1[v], v1[t[0]], v1[t[1]], v1[t[2]]};
-    if (np_filter && ccd.thickness == 0 && np_filter_culls(q)) {
+    if (separate_np() && np_filter_culls(q)) {
       ++c.vf_np;
       return;
     }
     const CcdResult r = vertex_face_ccd(q, ccd);
+    c.vf_np += counted_np(r);
     if (r.hit) out.push_back({v, f, t, r.toi});
   }
 
@@ -91,14 +106,50 @@ struct FeatureContext {
     const Edge& b = topo->edges()[eb];
     const EdgeEdgeQuery q{v0[a[0]], v0[a[1]], v0[b[0]], v0[b[1]],
                           v1[a[0]], v1[a[1]], v1[b[0]], v1[b[1]]};
-    if (np_filter && ccd.thickness == 0 && np_filter_culls(q)) {
+    if (separate_np() && np_filter_culls(q)) {
       ++c.ee_np;
       return;
     }
     const CcdResult r = edge_edge_ccd(q, ccd);
+    c.ee_np += counted_np(r);
     if (r.hit) out.push_back({ea, eb, a, b, r.toi});
   }
+
+ private:
+  // With the fast path on, the kernel starts with the same NP filter (one cubic, computed once);
+  // without it the filter runs on its own first.
+  [[nodiscard]] bool separate_np() const {
+    return np_filter && ccd.thickness == 0 && !ccd.fast_path;
+  }
+  [[nodiscard]] bool counted_np(const CcdResult& r) const {
+    return np_filter && r.path == CcdPath::np_culled;
+  }
 };
+
+/// Fills the context's box arrays for this step (in parallel), reusing the given storage: each
+/// box is then computed once per step instead of once per triangle pair that needs it.
+inline void precompute_boxes(FeatureContext& ctx, std::vector<Box>& vboxes,
+                             std::vector<Box>& eboxes, std::vector<Box>& fboxes) {
+  ctx.vboxes = {};
+  ctx.eboxes = {};
+  ctx.fboxes = {};
+  vboxes.resize(ctx.topo->num_vertices());
+  eboxes.resize(ctx.topo->num_edges());
+  fboxes.resize(ctx.topo->num_faces());
+  auto fill = [](std::vector<Box>& out, auto&& compute) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(out.size()), 4096),
+                      [&](const tbb::blocked_range<int>& r) {
+                        for (int i = r.begin(); i != r.end(); ++i)
+                          out[i] = compute(i);
+                      });
+  };
+  fill(vboxes, [&](int i) { return ctx.compute_vertex_box(i); });
+  fill(eboxes, [&](int i) { return ctx.compute_edge_box(i); });
+  fill(fboxes, [&](int i) { return ctx.compute_face_box(i); });
+  ctx.vboxes = vboxes;
+  ctx.eboxes = eboxes;
+  ctx.fboxes = fboxes;
+}
 
 /// Procedural R-triangle of (v, f): the first face of v, ascending, that shares no vertex with f
 /// (algorithms.md 6.3); -1 when every face of v touches f (an orphan).

@@ -45,8 +45,10 @@ struct CcdOptions {
 enum class CcdPath : std::uint8_t {
   trivial,    ///< decided before any solver (e.g. thickness larger than the query)
   np_culled,  ///< the Bernstein coefficients of the coplanarity cubic share a sign
-  fast_path,  ///< cubic root isolation, then inclusion restricted to the candidate times
+  fast_path,  ///< time ranges settled by the fast path, undecided ones by inclusion restricted to
+              ///< them
   inclusion,  ///< the inclusion solver over the whole of [0, 1]
+  certified,  ///< hit certified by the fast path: certain root, contact point certainly inside
 };
 
 struct CcdResult {

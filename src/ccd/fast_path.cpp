@@ -1,0 +1,112 @@
+#include "ccd/fast_path.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "ccd/certify.hpp"
+
+namespace clothcd::ccd_detail {
+
+namespace {
+
+// Ranges still undecided at this depth (2^-10 of the step) go to the inclusion solver.
+constexpr int kMaxLevel = 10;
+// Ranges examined (with the inside test) per query; past it the inclusion solver takes the rest of
+// the step. Bounds the cost of flat cubics (near-coplanar motion) whose sign is never certain.
+constexpr int kBudget = 48;
+// Subdivision error bounds hold to this depth.
+constexpr int kMaxRefine = 40;
+
+struct Node {
+  double b[4];
+  double lo, hi;
+  int level;
+};
+
+// Lower bound on the first root of the cubic on the node's range: the start of the earliest
+// range of width 2^-target on which the cubic is not provably of one sign.
+double first_root_bound(const Node& root, double e, int target) {
+  Node stack[kMaxRefine + 2];
+  int n = 0;
+  stack[n++] = root;
+  while (n > 0) {
+    const Node nd = stack[--n];
+    if (one_sign(nd.b, e)) continue;
+    if (nd.level >= target) return nd.lo;
+    const double mid = (nd.lo + nd.hi) * 0.5;
+    Node l{{}, nd.lo, mid, nd.level + 1}, r{{}, mid, nd.hi, nd.level + 1};
+    halve(nd.b, l.b, r.b);
+    stack[n++] = r;
+    stack[n++] = l;
+  }
+  // Unreachable when the bounds hold (the node has a certain sign change); stay conservative.
+  return root.lo;
+}
+
+}  // namespace
+
+FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
+                            const InclusionParams& p) {
+  const double e = subdivision_error(c);
+  const InsideData data = inside_data(kind, m);
+  // Depth at which the certified time of impact is within toi_tolerance of the root range.
+  int target = kMaxRefine;
+  if (p.toi_tolerance > 0) {
+    int exp = 0;
+    std::frexp(p.toi_tolerance, &exp);  // 2^(exp-1) <= tol < 2^exp
+    target = std::clamp(1 - exp, 0, kMaxRefine);
+  }
+  FastOutcome out;
+  InclusionParams q = p;
+  auto include = [&](double lo, double hi) {
+    q.t_lo = lo;
+    q.t_hi = hi;
+    const InclusionOutcome o = inclusion_solve(kind, m, q);
+    out.boxes += o.boxes;
+    if (o.hit) {
+      out.hit = true;
+      out.toi = o.toi;
+      out.u = o.u;
+      out.v = o.v;
+    }
+    return o.hit;
+  };
+  Node stack[kMaxLevel + 2];
+  int n = 0;
+  stack[n++] = Node{{c.k[0], c.k[1], c.k[2], c.k[3]}, 0.0, 1.0, 0};
+  int visited = 0;
+  // Depth-first, earlier half on top: when a range is examined, every earlier time is settled
+  // (no contact there), so the first contact found is the first contact of the step.
+  while (n > 0) {
+    const Node nd = stack[--n];
+    if (one_sign(nd.b, e)) continue;
+    if (++visited > kBudget) {
+      include(nd.lo, 1.0);
+      return out;
+    }
+    double u = 0, v = 0;
+    const Inside in = inside_over(data, nd.lo, nd.hi, u, v);
+    if (in == Inside::outside) continue;
+    if (in == Inside::inside && sign_change(nd.b, e)) {
+      // A root with the contact point strictly inside: a contact in this range, and none before.
+      out.hit = true;
+      out.certified = true;
+      out.toi = first_root_bound(nd, e, std::max(target, nd.level));
+      out.u = u;
+      out.v = v;
+      return out;
+    }
+    if (nd.level >= kMaxLevel) {
+      if (include(nd.lo, nd.hi)) return out;
+      continue;
+    }
+    const double mid = (nd.lo + nd.hi) * 0.5;
+    Node l{{}, nd.lo, mid, nd.level + 1}, r{{}, mid, nd.hi, nd.level + 1};
+    halve(nd.b, l.b, r.b);
+    stack[n++] = r;
+    stack[n++] = l;
+  }
+  return out;
+}
+
+}  // namespace clothcd::ccd_detail

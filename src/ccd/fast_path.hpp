@@ -1,0 +1,27 @@
+#pragma once
+// Internal: the zero-thickness fast path. A depth-first search over time ranges, earliest first,
+// that drops a range when the coplanarity cubic provably has no root on it or the contact point
+// is provably outside the features over it, certifies a hit when the cubic provably changes sign
+// on it and the contact point is provably inside over all of it, and hands the ranges it cannot
+// decide (after a few halvings) to the inclusion solver restricted to that range.
+
+#include <cstdint>
+
+#include "ccd/cubic.hpp"
+#include "ccd/inclusion.hpp"
+
+namespace clothcd::ccd_detail {
+
+struct FastOutcome {
+  bool hit = false;
+  bool certified = false;  ///< decided without the inclusion solver
+  double toi = 1, u = 0, v = 0;
+  std::uint32_t boxes = 0;  ///< inclusion boxes spent on undecided ranges
+};
+
+/// `p` gives the inclusion solver's settings (its time range is ignored); `c` is the query's
+/// coplanarity cubic (not NP-culled).
+FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
+                            const InclusionParams& p);
+
+}  // namespace clothcd::ccd_detail
