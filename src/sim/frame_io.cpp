@@ -155,8 +155,20 @@ nlohmann::json to_json(const FrameStats& s) {
           {"collision_seconds", s.collision_seconds},
           {"max_stretch", s.max_stretch},
           {"body_displacement", s.body_displacement},
-          {"intersecting_pairs", nullptr},  // no collision stage yet
-          {"finite", s.finite}};
+          {"finite", s.finite},
+          {"proximity_pairs", s.proximity_pairs},
+          {"ccd_hits", s.ccd_hits},
+          {"ccd_passes", s.ccd_passes},
+          {"zones", s.zones},
+          {"largest_zone", s.largest_zone},
+          {"zone_rounds", s.zone_rounds},
+          {"unresolved_ccd_hits", s.unresolved},
+          // null when not counted (a non-finite state or counting switched off)
+          {"self_intersections",
+           s.self_intersections >= 0 ? nlohmann::json(s.self_intersections) : nlohmann::json()},
+          {"body_intersections",
+           s.body_intersections >= 0 ? nlohmann::json(s.body_intersections) : nlohmann::json()},
+          {"intersection_seconds", s.intersection_seconds}};
 }
 
 std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
@@ -177,9 +189,18 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
   int done = 0;
   if (opt.resume && fs::exists(manifest_path)) {
     std::ifstream in(manifest_path);
+    std::string state_file;
     try {
       manifest = nlohmann::json::parse(in);
       done = manifest.at("complete_frames").get<int>();
+      // Read here so that a manifest lacking them is an InputError naming it, not a bare
+      // json exception.
+      state_file = manifest.at("state_file").get<std::string>();
+      if (!manifest.at("frames").is_array()) {
+        throw input_error(manifest_path.string(), 0, "'frames' is not an array");
+      }
+      for (const auto& f : manifest.at("frames"))
+        (void)f.at("frame").get<int>();
       if (manifest.at("vertices").get<int>() != n ||
           manifest.at("scene").get<std::string>() != scene.name) {
         throw input_error(manifest_path.string(), 0,
@@ -193,8 +214,7 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                         fmt::format("unreadable manifest: {}", e.what()));
     }
     int state_frame = -1;
-    ClothState st =
-        read_state(opt.out / manifest.at("state_file").get<std::string>(), n, state_frame);
+    ClothState st = read_state(opt.out / state_file, n, state_frame);
     if (state_frame != done) {
       throw input_error(
           manifest_path.string(), 0,
@@ -214,8 +234,23 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                 {"mesh_format", ext},
                 {"slivers", sim.model().num_slivers()},
                 {"stitches", sim.model().stitches().size()},
-                {"collisions", false},
+                {"collisions", scene.collisions},
                 {"frames", nlohmann::json::array()}};
+    if (scene.collisions) {
+      const ContactOptions& c = scene.contact;
+      manifest["contact"] = {{"self", c.self},
+                             {"body", c.body},
+                             {"thickness", c.thickness},
+                             {"ccd_thickness", c.ccd_thickness},
+                             {"ccd_iterations", c.ccd_iterations},
+                             {"zone_rounds", c.zone_rounds},
+                             {"friction", c.friction}};
+    }
+    if (scene.count_intersections) {
+      const IntersectionCount ic = sim.count_intersections();
+      manifest["initial_self_intersections"] = ic.self;
+      manifest["initial_body_intersections"] = ic.body;
+    }
     write_mesh_atomic(opt.out / frame_name(0, ext), sim.state().x, faces, ext);
     const std::string sname = state_name(0);
     write_state_atomic(opt.out / sname, sim.state(), 0);

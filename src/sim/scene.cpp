@@ -122,8 +122,14 @@ GridInfo read_grid(ObjectReader g, ClothMeshInput& cloth) {
   const Vec3 u = g.vec3("u", Vec3(1, 0, 0));
   const Vec3 v = g.vec3("v", Vec3(0, 0, 1));
   const json& res = g.get("resolution");
-  if (!res.is_array() || res.size() != 2 || !res[0].is_number_integer() ||
-      !res[1].is_number_integer() || res[0].get<int>() < 1 || res[1].get<int>() < 1 ||
+  // Each side is bounded before the product, which could otherwise overflow (and before get<int>,
+  // which would narrow 2^32 + 1 to 1).
+  auto side_ok = [](const json& x) {
+    if (x.is_number_unsigned()) return x.get<std::uint64_t>() - 1 < 4'000'000;
+    return x.is_number_integer() && x.get<std::int64_t>() >= 1 &&
+           x.get<std::int64_t>() <= 4'000'000;
+  };
+  if (!res.is_array() || res.size() != 2 || !side_ok(res[0]) || !side_ok(res[1]) ||
       res[0].get<long long>() * res[1].get<long long>() > 4'000'000) {
     g.fail(g.key("resolution"), "expected [nu, nv], two positive integers (nu * nv <= 4e6)");
   }
@@ -379,6 +385,28 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
       s.pins.push_back(std::move(g));
     }
   }
+  if (top.has("collisions")) {
+    ObjectReader o = top.object("collisions");
+    auto boolean = [&](const std::string& k, bool def) {
+      if (!o.has(k)) return def;
+      const json& v = o.get(k);
+      if (!v.is_boolean())
+        o.fail(o.key(k), fmt::format("expected true or false, got {}", v.dump()));
+      return v.get<bool>();
+    };
+    ContactOptions& c = s.contact;
+    s.collisions = boolean("enabled", true);
+    c.self = boolean("self", c.self);
+    c.body = boolean("body", c.body);
+    c.thickness = o.number("thickness", c.thickness, 0.0, 1.0);
+    c.ccd_thickness = o.number("ccd_thickness", c.ccd_thickness, 0.0, 1.0);
+    c.ccd_iterations = o.integer("ccd_iterations", c.ccd_iterations, 1, 1000);
+    c.zone_rounds = o.integer("zone_rounds", c.zone_rounds, 0, 10000);
+    c.repulsion_fraction = o.number("repulsion_fraction", c.repulsion_fraction, 0.0, 1.0);
+    s.count_intersections = boolean("count_intersections", s.count_intersections);
+    o.finish();
+  }
+  s.contact.friction = s.material.friction;
   if (top.has("output")) {
     ObjectReader o = top.object("output");
     s.output_format = o.string("format", "obj", {"obj", "ply"});

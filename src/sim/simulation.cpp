@@ -11,7 +11,31 @@ Simulation::Simulation(Scene scene) : scene_(std::move(scene)) {
   for (const PinGroup& g : scene_.pins)
     solver_->add_pins(g, model_->initial_positions());
   solver_->set_body(scene_.body.get());
+  if (scene_.collisions) {
+    contact_ = std::make_unique<ContactHandler>(*model_, scene_.contact);
+    solver_->set_collision_handler(contact_.get());
+  }
+  static const std::vector<Face> kNoFaces;
+  counter_ = std::make_unique<IntersectionCounter>(model_->topology(), model_->stitches(),
+                                                   scene_.body ? scene_.body->faces() : kNoFaces,
+                                                   scene_.body ? scene_.body->num_vertices() : 0);
   state_ = solver_->initial_state();
+}
+
+Simulation::~Simulation() = default;
+
+std::vector<Vec3> Simulation::body_positions() {
+  std::vector<Vec3> b;
+  if (scene_.body) scene_.body->positions_at(state_.time, b);
+  return b;
+}
+
+IntersectionCount Simulation::count_intersections() {
+  IntersectionCount c;
+  c.self = static_cast<long long>(counter_->self_pairs(state_.x).size());
+  if (scene_.body)
+    c.body = static_cast<long long>(counter_->body_pairs(state_.x, body_positions()).size());
+  return c;
 }
 
 void Simulation::set_state(ClothState state, int frame) {
@@ -36,6 +60,13 @@ FrameStats Simulation::advance_frame() {
     fs.halvings += st.halvings;
     fs.pcg_converged = fs.pcg_converged && st.converged;
     fs.collision_seconds += st.collision.seconds;
+    fs.proximity_pairs += st.collision.proximity_pairs;
+    fs.ccd_hits += st.collision.ccd_hits;
+    fs.ccd_passes += st.collision.ccd_passes;
+    fs.zones += st.collision.zones;
+    fs.largest_zone = std::max(fs.largest_zone, st.collision.largest_zone);
+    fs.zone_rounds += st.collision.zone_rounds;
+    fs.unresolved += st.collision.unresolved;
   }
   state_.time = t1;
   ++frame_;
@@ -46,6 +77,14 @@ FrameStats Simulation::advance_frame() {
     fs.finite = fs.finite && x.allFinite();
   for (const Vec3& v : state_.v)
     fs.finite = fs.finite && v.allFinite();
+  if (scene_.count_intersections && fs.finite) {
+    const auto t = std::chrono::steady_clock::now();
+    const IntersectionCount c = count_intersections();
+    fs.self_intersections = c.self;
+    fs.body_intersections = scene_.body ? c.body : 0;
+    fs.intersection_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  }
   fs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return fs;
 }

@@ -32,6 +32,8 @@ struct CollisionStats {
   int ccd_passes = 0;
   int zones = 0;
   int largest_zone = 0;
+  int zone_rounds = 0;
+  long long unresolved = 0;  ///< CCD hits still present when the zone rounds ran out
   double seconds = 0.0;
 };
 

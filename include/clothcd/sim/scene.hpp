@@ -13,6 +13,7 @@
 
 #include "clothcd/sim/body.hpp"
 #include "clothcd/sim/cloth_model.hpp"
+#include "clothcd/sim/contact_handler.hpp"
 #include "clothcd/sim/integrator.hpp"
 
 namespace clothcd::sim {
@@ -37,6 +38,11 @@ struct Scene {
   int frames = 120;
   SubstepRule substeps;
   std::string output_format = "obj";  ///< "obj" or "ply"
+  /// The collision stage (`collisions` key); off when the scene has no such key.
+  bool collisions = false;
+  ContactOptions contact;
+  /// Count intersecting triangle pairs after every frame (`collisions.count_intersections`).
+  bool count_intersections = true;
 };
 
 /// Reads and validates a scene. Throws clothcd::InputError naming the scene file and the key

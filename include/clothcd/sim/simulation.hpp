@@ -5,6 +5,8 @@
 
 #include <memory>
 
+#include "clothcd/sim/contact_handler.hpp"
+#include "clothcd/sim/intersections.hpp"
 #include "clothcd/sim/scene.hpp"
 
 namespace clothcd::sim {
@@ -24,12 +26,31 @@ struct FrameStats {
   double max_stretch = 0.0;  ///< at the end of the frame
   double body_displacement = 0.0;
   bool finite = true;
+  // Collision stage, summed over the frame's substeps (zero without collisions).
+  long long proximity_pairs = 0;
+  long long ccd_hits = 0;
+  int ccd_passes = 0;
+  int zones = 0;  ///< summed over substeps
+  int largest_zone = 0;
+  int zone_rounds = 0;
+  long long unresolved = 0;  ///< CCD hits left when zone rounds ran out
+  /// Intersecting triangle pairs at the frame's end (-1: not counted).
+  long long self_intersections = -1;
+  long long body_intersections = -1;
+  double intersection_seconds = 0.0;
+};
+
+/// Intersecting triangle pairs of one state.
+struct IntersectionCount {
+  long long self = 0;
+  long long body = 0;
 };
 
 class Simulation {
  public:
   /// Takes the scene's body and pins. Throws InputError on inconsistent pins.
   explicit Simulation(Scene scene);
+  ~Simulation();
 
   [[nodiscard]] const Scene& scene() const { return scene_; }
   [[nodiscard]] const ClothModel& model() const { return *model_; }
@@ -41,7 +62,14 @@ class Simulation {
 
   FrameStats advance_frame();
 
+  /// Intersecting triangle pairs (cloth-cloth, cloth-body) at the current state and time.
+  [[nodiscard]] IntersectionCount count_intersections();
+  /// The body's vertices at the current time (empty without a body).
+  [[nodiscard]] std::vector<Vec3> body_positions();
+
  private:
+  std::unique_ptr<ContactHandler> contact_;
+  std::unique_ptr<IntersectionCounter> counter_;
   Scene scene_;
   std::unique_ptr<ClothModel> model_;
   std::unique_ptr<ClothSolver> solver_;

@@ -1,0 +1,48 @@
+#pragma once
+/// @file
+/// The collision stage (docs/simulator.md 3; reference ../shared/docs/simulator.md 3): per
+/// substep, proximity repulsion and friction within the cloth thickness, then CCD passes with
+/// inelastic pair impulses (Bridson, Fedkiw, Anderson 2002), then rigid impact zones (Provot 1997)
+/// as the fail-safe. Cloth self contact goes through clothcd::SelfDetector (sound culling only),
+/// cloth-body CCD through clothcd::PairDetector. Body vertices have infinite mass, and so have
+/// pinned cloth vertices. Processing is sequential over sorted pairs, so results do not depend on
+/// the thread count.
+
+#include <memory>
+#include <span>
+
+#include "clothcd/sim/cloth_model.hpp"
+#include "clothcd/sim/collision.hpp"
+
+namespace clothcd::sim {
+
+struct ContactOptions {
+  bool self = true;             ///< cloth-cloth contact
+  bool body = true;             ///< cloth-body contact
+  double thickness = 1e-3;      ///< repulsion distance d-hat (m)
+  double ccd_thickness = 1e-5;  ///< minimum separation the CCD keeps (m)
+  int ccd_iterations = 5;       ///< impulse passes before impact zones
+  int zone_rounds = 30;         ///< impact-zone rounds before giving up
+  /// Share of the overlap d-hat - d that repulsion removes per substep.
+  double repulsion_fraction = 0.1;
+  double friction = 0.2;  ///< Coulomb coefficient of the contact impulses
+};
+
+class ContactHandler final : public CollisionHandler {
+ public:
+  /// `model` must outlive the handler; its stitches mark pairs that never collide.
+  ContactHandler(const ClothModel& model, const ContactOptions& options);
+  ~ContactHandler() override;
+
+  void prepare(const SubstepContext& ctx) override;
+  CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v_star) override;
+
+  [[nodiscard]] const ContactOptions& options() const { return options_; }
+
+ private:
+  struct Impl;
+  ContactOptions options_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clothcd::sim

@@ -1,0 +1,507 @@
+// Collision response: proximity repulsion + friction, CCD impulse passes, rigid impact zones.
+#include "clothcd/sim/contact_handler.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <optional>
+
+#include "bvh_pairs.hpp"
+#include "clothcd/bvh/bvh.hpp"
+#include "clothcd/ccd/proximity.hpp"
+#include "clothcd/detect/detector.hpp"
+#include "seam_links.hpp"
+
+namespace clothcd::sim {
+namespace {
+
+// A contact as four points with signed weights c_k (docs/simulator.md 3.2): VF is
+// (1, -w0, -w1, -w2), EE is (1 - s, s, -(1 - t), -t). `n` points from the negative side to the
+// positive one; `gap` is the signed distance n . sum c_k x_k at the substep start.
+struct Contact {
+  std::array<int, 4> id{};
+  std::array<bool, 4> on_body{};
+  std::array<double, 4> c{};
+  Vec3 n = Vec3::Zero();
+  double gap = 0.0;
+};
+
+Positions to_matrix(std::span<const Vec3> x) {
+  Positions m(static_cast<Eigen::Index>(x.size()), 3);
+  for (std::size_t i = 0; i < x.size(); ++i)
+    m.row(static_cast<Eigen::Index>(i)) = x[i].transpose();
+  return m;
+}
+
+bool normalize(Vec3& n) {
+  const double l = n.norm();
+  if (!(l > 1e-14)) return false;
+  n /= l;
+  return true;
+}
+
+class UnionFind {
+ public:
+  explicit UnionFind(int n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  int find(int a) {
+    while (parent_[a] != a) {
+      parent_[a] = parent_[parent_[a]];
+      a = parent_[a];
+    }
+    return a;
+  }
+  // The smaller id becomes the root, so zones do not depend on the merge order.
+  void unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return;
+    if (b < a) std::swap(a, b);
+    parent_[b] = a;
+  }
+
+ private:
+  std::vector<int> parent_;
+};
+
+}  // namespace
+
+struct ContactHandler::Impl {
+  const ClothModel& model;
+  ContactOptions opt;
+  detail::SeamLinks links;
+  std::optional<SelfDetector> self;
+  // Body: CCD through the pair detector; proximity through static BVHs of both meshes.
+  std::optional<PairDetector> body_ccd;
+  std::optional<Topology> body_topo;
+  Bvh cloth_bvh, body_bvh;
+  std::vector<Contact> proximity;
+  // Per-substep scratch.
+  std::span<const Vec3> x0, b0, b1;
+  std::vector<Vec3> vb;
+  std::span<const double> inv_mass;
+  double h = 0.0;
+  Positions x0m, b0m, b1m;
+
+  Impl(const ClothModel& m, const ContactOptions& o)
+      : model(m), opt(o), links(m.num_vertices(), m.stitches()) {}
+
+  [[nodiscard]] const Vec3& position(const Contact& c, int k, double tau, std::span<const Vec3> v,
+                                     Vec3& tmp) const {
+    const int i = c.id[k];
+    if (c.on_body[k]) {
+      tmp = b0[i] + tau * (b1[i] - b0[i]);
+    } else {
+      tmp = tau == 0.0 ? x0[i] : Vec3(x0[i] + tau * h * v[i]);
+    }
+    return tmp;
+  }
+  [[nodiscard]] Vec3 velocity(const Contact& c, int k, std::span<const Vec3> v) const {
+    return c.on_body[k] ? vb[c.id[k]] : v[c.id[k]];
+  }
+  [[nodiscard]] double weight(const Contact& c, int k) const {
+    return c.on_body[k] ? 0.0 : inv_mass[c.id[k]];
+  }
+  [[nodiscard]] Vec3 relative_velocity(const Contact& c, std::span<const Vec3> v) const {
+    Vec3 r = Vec3::Zero();
+    for (int k = 0; k < 4; ++k)
+      r += c.c[k] * velocity(c, k, v);
+    return r;
+  }
+  // Changes the contact's relative velocity by delta * dir; false when every point is fixed.
+  bool impulse(const Contact& c, const Vec3& dir, double delta, std::span<Vec3> v) const {
+    double denom = 0.0;
+    for (int k = 0; k < 4; ++k)
+      denom += c.c[k] * c.c[k] * weight(c, k);
+    if (!(denom > 0.0)) return false;
+    const double j = delta / denom;
+    for (int k = 0; k < 4; ++k) {
+      if (!c.on_body[k]) v[c.id[k]] += (c.c[k] * j * weight(c, k)) * dir;
+    }
+    return true;
+  }
+
+  // Orients n so that the contact's start gap is >= 0; false for a degenerate normal.
+  bool finish(Contact& c, Vec3 n, std::span<const Vec3> v, const Vec3& fallback) const {
+    if (!normalize(n)) {
+      n = fallback;
+      if (!normalize(n)) return false;
+    }
+    Vec3 tmp, s = Vec3::Zero();
+    for (int k = 0; k < 4; ++k)
+      s += c.c[k] * position(c, k, 0.0, v, tmp);
+    c.gap = n.dot(s);
+    if (c.gap < 0) {
+      n = -n;
+      c.gap = -c.gap;
+    }
+    c.n = n;
+    return true;
+  }
+
+  // A vertex-face contact at time tau of the substep (0: proximity at the start).
+  bool make_vf(Contact& c, int p, bool p_body, int f, bool f_body, double tau,
+               std::span<const Vec3> v) const {
+    const Face& t = f_body ? body_topo->faces()[f] : model.topology().faces()[f];
+    c.id = {p, t[0], t[1], t[2]};
+    c.on_body = {p_body, f_body, f_body, f_body};
+    std::array<Vec3, 4> q;
+    for (int k = 0; k < 4; ++k)
+      q[k] = position(c, k, tau, v, q[k]);
+    const PointTriangleProximity pr = point_triangle_proximity(q[0], q[1], q[2], q[3]);
+    c.c = {1.0, -pr.weights[0], -pr.weights[1], -pr.weights[2]};
+    const Vec3 face_n = (q[2] - q[1]).cross(q[3] - q[1]);
+    const Vec3 toward = q[0] - pr.closest;
+    // Proximity uses the closest-point direction; CCD (touching) the face normal.
+    if (tau == 0.0 && pr.distance > 1e-9) return finish(c, toward, v, face_n);
+    return finish(c, face_n, v, toward);
+  }
+
+  bool make_ee(Contact& c, int ea, bool a_body, int eb, bool b_body, double tau,
+               std::span<const Vec3> v) const {
+    const Edge& x = a_body ? body_topo->edges()[ea] : model.topology().edges()[ea];
+    const Edge& y = b_body ? body_topo->edges()[eb] : model.topology().edges()[eb];
+    c.id = {x[0], x[1], y[0], y[1]};
+    c.on_body = {a_body, a_body, b_body, b_body};
+    std::array<Vec3, 4> q;
+    for (int k = 0; k < 4; ++k)
+      q[k] = position(c, k, tau, v, q[k]);
+    const EdgeEdgeProximity pr = edge_edge_proximity(q[0], q[1], q[2], q[3]);
+    c.c = {1.0 - pr.s, pr.s, -(1.0 - pr.t), -pr.t};
+    const Vec3 cross = (q[1] - q[0]).cross(q[3] - q[2]);
+    const Vec3 toward = pr.closest_a - pr.closest_b;
+    if (tau == 0.0 && pr.distance > 1e-9) return finish(c, toward, v, cross);
+    return finish(c, cross, v, toward);
+  }
+
+  [[nodiscard]] bool vf_linked(int v, int f) const {
+    const std::array<int, 1> a{v};
+    return links.any_linked(a, model.topology().faces()[f]);
+  }
+  [[nodiscard]] bool ee_linked(int a, int b) const {
+    return links.any_linked(model.topology().edges()[a], model.topology().edges()[b]);
+  }
+
+  void ensure_body(const SubstepContext& ctx) {
+    if (body_topo) return;
+    const int nb = static_cast<int>(ctx.body_t0.size());
+    body_topo.emplace(*ctx.body_faces, nb);
+    DetectOptions o;
+    o.culling = Culling::None;
+    o.thickness = opt.ccd_thickness;
+    body_ccd.emplace(model.topology().faces(), model.num_vertices(), x0m, *ctx.body_faces, nb, b0m,
+                     o);
+    cloth_bvh = Bvh(model.topology(), ctx.x0, BvhBuild::Spatial);
+    body_bvh = Bvh(*body_topo, ctx.body_t0, BvhBuild::Spatial);
+  }
+
+  [[nodiscard]] bool has_body(const SubstepContext& ctx) const {
+    return opt.body && ctx.body_faces != nullptr && !ctx.body_t0.empty();
+  }
+
+  void prepare(const SubstepContext& ctx) {
+    x0 = ctx.x0;
+    b0 = ctx.body_t0;
+    b1 = ctx.body_t1;
+    h = ctx.h;
+    inv_mass = ctx.inverse_mass;
+    x0m = to_matrix(x0);
+    proximity.clear();
+    const std::span<const Vec3> none;
+    const double dh = opt.thickness;
+    if (opt.self) {
+      if (!self) {
+        DetectOptions o;
+        o.culling = Culling::Sound;  // never the unsound cone rules in the simulator
+        o.thickness = opt.ccd_thickness;
+        self.emplace(model.topology().faces(), model.num_vertices(), x0m, o);
+      }
+      const ProximityResult r = self->proximity(x0m, dh);
+      for (const auto& p : r.vf) {
+        if (vf_linked(p.vertex, p.face)) continue;
+        Contact c;
+        if (make_vf(c, p.vertex, false, p.face, false, 0.0, none)) proximity.push_back(c);
+      }
+      for (const auto& p : r.ee) {
+        if (ee_linked(p.edge_a, p.edge_b)) continue;
+        Contact c;
+        if (make_ee(c, p.edge_a, false, p.edge_b, false, 0.0, none)) proximity.push_back(c);
+      }
+    }
+    if (has_body(ctx)) {
+      b0m = to_matrix(b0);
+      ensure_body(ctx);
+      RefitOptions ro;
+      ro.cones = false;
+      ro.thickness = dh;
+      cloth_bvh.refit(x0, ro);
+      body_bvh.refit(b0, ro);
+      std::vector<std::pair<int, int>> vf_cb, vf_bc, ee;
+      const auto& cf = model.topology().faces();
+      const auto& bf = body_topo->faces();
+      detail::for_each_overlap(cloth_bvh, body_bvh, [&](int f, int g) {
+        for (int v : cf[f])
+          vf_cb.emplace_back(v, g);
+        for (int u : bf[g])
+          vf_bc.emplace_back(u, f);
+        for (int a : model.topology().face_edges(f)) {
+          for (int b : body_topo->face_edges(g))
+            ee.emplace_back(a, b);
+        }
+      });
+      for (auto* l : {&vf_cb, &vf_bc, &ee}) {
+        std::sort(l->begin(), l->end());
+        l->erase(std::unique(l->begin(), l->end()), l->end());
+      }
+      for (const auto& [v, g] : vf_cb) {
+        const Face& t = bf[g];
+        if (point_triangle_proximity(x0[v], b0[t[0]], b0[t[1]], b0[t[2]]).distance > dh) continue;
+        Contact c;
+        if (make_vf(c, v, false, g, true, 0.0, none)) proximity.push_back(c);
+      }
+      for (const auto& [u, f] : vf_bc) {
+        const Face& t = cf[f];
+        if (point_triangle_proximity(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]).distance > dh) continue;
+        Contact c;
+        if (make_vf(c, u, true, f, false, 0.0, none)) proximity.push_back(c);
+      }
+      for (const auto& [a, b] : ee) {
+        const Edge& x = model.topology().edges()[a];
+        const Edge& y = body_topo->edges()[b];
+        if (edge_edge_proximity(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]]).distance > dh) continue;
+        Contact c;
+        if (make_ee(c, a, false, b, true, 0.0, none)) proximity.push_back(c);
+      }
+    }
+  }
+
+  // All CCD hits of the motion x0 -> x0 + h v (self restricted to `active` faces when given).
+  std::vector<Contact> hits(const SubstepContext& ctx, std::span<const Vec3> v,
+                            const std::vector<int>* active) {
+    std::vector<Contact> out;
+    std::vector<Vec3> x1(x0.size());
+    for (std::size_t i = 0; i < x0.size(); ++i)
+      x1[i] = x0[i] + h * v[i];
+    const Positions x1m = to_matrix(x1);
+    if (opt.self) {
+      if (active != nullptr) {
+        self->set_active_faces(*active);
+      } else {
+        self->clear_active_faces();
+      }
+      const DetectResult r = self->detect(x0m, x1m);
+      for (const auto& p : r.vf) {
+        if (vf_linked(p.vertex, p.face)) continue;
+        Contact c;
+        if (make_vf(c, p.vertex, false, p.face, false, p.toi, v)) out.push_back(c);
+      }
+      for (const auto& p : r.ee) {
+        if (ee_linked(p.edge_a, p.edge_b)) continue;
+        Contact c;
+        if (make_ee(c, p.edge_a, false, p.edge_b, false, p.toi, v)) out.push_back(c);
+      }
+    }
+    if (has_body(ctx)) {
+      const PairDetectResult r = body_ccd->detect(x0m, x1m, b0m, b1m);
+      for (const auto& p : r.vf_a_on_b) {
+        Contact c;
+        if (make_vf(c, p.vertex, false, p.face, true, p.toi, v)) out.push_back(c);
+      }
+      for (const auto& p : r.vf_b_on_a) {
+        Contact c;
+        if (make_vf(c, p.vertex, true, p.face, false, p.toi, v)) out.push_back(c);
+      }
+      for (const auto& p : r.ee) {
+        Contact c;
+        if (make_ee(c, p.edge_a, false, p.edge_b, true, p.toi, v)) out.push_back(c);
+      }
+    }
+    return out;
+  }
+
+  // Faces incident to the flagged vertices.
+  std::vector<int> faces_of(const std::vector<std::uint8_t>& flag) const {
+    std::vector<int> faces;
+    const Topology& t = model.topology();
+    for (int f = 0; f < t.num_faces(); ++f) {
+      const Face& x = t.faces()[f];
+      if (flag[x[0]] || flag[x[1]] || flag[x[2]]) faces.push_back(f);
+    }
+    return faces;
+  }
+
+  CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v) {
+    CollisionStats st;
+    const int n = model.num_vertices();
+    vb.assign(b0.size(), Vec3::Zero());
+    if (has_body(ctx)) {
+      b1m = to_matrix(b1);
+      for (std::size_t i = 0; i < b0.size(); ++i)
+        vb[i] = (b1[i] - b0[i]) / h;
+    }
+    // 1. Repulsion and friction (sorted pairs, Gauss-Seidel).
+    st.proximity_pairs = static_cast<long long>(proximity.size());
+    for (const Contact& c : proximity) {
+      const double target = opt.repulsion_fraction * (opt.thickness - c.gap) / h;
+      const Vec3 rel = relative_velocity(c, v);
+      const double vn = c.n.dot(rel);
+      if (vn >= target) continue;
+      const double dn = target - vn;
+      if (!impulse(c, c.n, dn, v)) continue;
+      Vec3 vt = rel - vn * c.n;
+      const double lt = vt.norm();
+      if (opt.friction > 0 && lt > 0) impulse(c, -vt / lt, std::min(opt.friction * dn, lt), v);
+    }
+    // 2. CCD passes with inelastic impulses; later passes test only faces whose vertices moved.
+    std::vector<std::uint8_t> touched(n, 0);
+    std::vector<int> active;
+    bool clean = false;
+    for (int pass = 0; pass < opt.ccd_iterations; ++pass) {
+      const std::vector<Contact> hs = hits(ctx, v, pass == 0 ? nullptr : &active);
+      ++st.ccd_passes;
+      st.ccd_hits += static_cast<long long>(hs.size());
+      if (hs.empty()) {
+        clean = true;
+        break;
+      }
+      std::fill(touched.begin(), touched.end(), 0);
+      for (const Contact& c : hs) {
+        for (int k = 0; k < 4; ++k) {
+          if (!c.on_body[k]) touched[c.id[k]] = 1;
+        }
+        // Keep at least twice the CCD separation at the end of the substep.
+        const double target = std::max(0.0, (2.0 * opt.ccd_thickness - c.gap) / h);
+        const double vn = c.n.dot(relative_velocity(c, v));
+        if (vn < target) impulse(c, c.n, target - vn, v);
+      }
+      active = faces_of(touched);
+    }
+    if (!clean) zones(ctx, v, touched, st);
+    if (opt.self) self->clear_active_faces();
+    return st;
+  }
+
+  // Rigid impact zones (Provot 1997); a zone touching the body or a pinned vertex moves with the
+  // mean velocity of those anchors (body points have infinite mass).
+  void zones(const SubstepContext& ctx, std::span<Vec3> v, std::vector<std::uint8_t>& changed,
+             CollisionStats& st) {
+    const int n = model.num_vertices();
+    UnionFind uf(n);
+    std::vector<std::uint8_t> in_zone(n, 0);
+    std::vector<std::pair<int, Vec3>> anchors;  // cloth vertex, velocity it must follow
+    std::vector<int> active = faces_of(changed);
+    const auto& mass = model.mass();
+    for (int round = 0;; ++round) {
+      const std::vector<Contact> hs = hits(ctx, v, &active);
+      if (hs.empty()) break;
+      if (round == opt.zone_rounds) {
+        st.unresolved = static_cast<long long>(hs.size());
+        break;
+      }
+      ++st.zone_rounds;
+      for (const Contact& c : hs) {
+        int first = -1;
+        Vec3 body_v = Vec3::Zero();
+        double body_w = 0.0;
+        for (int k = 0; k < 4; ++k) {
+          if (c.on_body[k]) {
+            body_v += std::abs(c.c[k]) * vb[c.id[k]];
+            body_w += std::abs(c.c[k]);
+            continue;
+          }
+          in_zone[c.id[k]] = 1;
+          if (first < 0) {
+            first = c.id[k];
+          } else {
+            uf.unite(first, c.id[k]);
+          }
+        }
+        if (body_w > 0) {
+          for (int k = 0; k < 4; ++k) {
+            if (!c.on_body[k]) anchors.emplace_back(c.id[k], body_v / body_w);
+          }
+        }
+      }
+      // Members of each zone, in vertex order.
+      std::vector<std::vector<int>> members;
+      std::vector<int> zone_of(n, -1), root_zone(n, -1);
+      for (int i = 0; i < n; ++i) {
+        if (!in_zone[i]) continue;
+        const int r = uf.find(i);
+        if (root_zone[r] < 0) {
+          root_zone[r] = static_cast<int>(members.size());
+          members.emplace_back();
+        }
+        zone_of[i] = root_zone[r];
+        members[zone_of[i]].push_back(i);
+      }
+      std::vector<Vec3> anchor_sum(members.size(), Vec3::Zero());
+      std::vector<int> anchor_count(members.size(), 0);
+      for (const auto& [i, vel] : anchors) {
+        anchor_sum[zone_of[i]] += vel;
+        ++anchor_count[zone_of[i]];
+      }
+      std::fill(changed.begin(), changed.end(), 0);
+      st.zones = static_cast<int>(members.size());
+      for (std::size_t z = 0; z < members.size(); ++z) {
+        const auto& m = members[z];
+        st.largest_zone = std::max(st.largest_zone, static_cast<int>(m.size()));
+        for (int i : m) {
+          changed[i] = 1;
+          if (inv_mass[i] == 0.0) {
+            anchor_sum[z] += v[i];
+            ++anchor_count[z];
+          }
+        }
+        if (anchor_count[z] > 0) {
+          const Vec3 target = anchor_sum[z] / anchor_count[z];
+          for (int i : m) {
+            if (inv_mass[i] != 0.0) v[i] = target;
+          }
+          continue;
+        }
+        double mt = 0.0;
+        Vec3 xc = Vec3::Zero(), vc = Vec3::Zero();
+        for (int i : m) {
+          mt += mass[i];
+          xc += mass[i] * x0[i];
+          vc += mass[i] * v[i];
+        }
+        xc /= mt;
+        vc /= mt;
+        Vec3 l = Vec3::Zero();
+        Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+        for (int i : m) {
+          const Vec3 r = x0[i] - xc;
+          l += mass[i] * r.cross(v[i] - vc);
+          inertia += mass[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+        }
+        // Pseudo-inverse: a collinear zone has no inertia about its line.
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(inertia);
+        const Vec3 ev = es.eigenvalues();
+        Vec3 w = es.eigenvectors().transpose() * l;
+        for (int k = 0; k < 3; ++k)
+          w[k] = ev[k] > 1e-12 * std::max(ev[2], 1e-300) ? w[k] / ev[k] : 0.0;
+        const Vec3 omega = es.eigenvectors() * w;
+        for (int i : m)
+          v[i] = vc + omega.cross(x0[i] - xc);
+      }
+      active = faces_of(changed);
+    }
+  }
+};
+
+ContactHandler::ContactHandler(const ClothModel& model, const ContactOptions& options)
+    : options_(options), impl_(std::make_unique<Impl>(model, options)) {}
+ContactHandler::~ContactHandler() = default;
+
+void ContactHandler::prepare(const SubstepContext& ctx) {
+  impl_->prepare(ctx);
+}
+
+CollisionStats ContactHandler::respond(const SubstepContext& ctx, std::span<Vec3> v_star) {
+  return impl_->respond(ctx, v_star);
+}
+
+}  // namespace clothcd::sim

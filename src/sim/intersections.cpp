@@ -1,0 +1,142 @@
+// Discrete intersection counting: BVH prefilter, edge-through-triangle test.
+#include "clothcd/sim/intersections.hpp"
+
+#include <algorithm>
+#include <optional>
+
+#include "bvh_pairs.hpp"
+#include "clothcd/bvh/bvh.hpp"
+#include "seam_links.hpp"
+
+namespace clothcd::sim {
+namespace {
+
+double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return (b - a).cross(c - a).dot(d - a);
+}
+
+// Segment pq passes strictly through the plane of abc at a point inside (or on the border of) abc.
+bool segment_crosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double dp = orient(a, b, c, p);
+  const double dq = orient(a, b, c, q);
+  if (!((dp > 0 && dq < 0) || (dp < 0 && dq > 0))) return false;
+  const double s0 = orient(p, q, a, b);
+  const double s1 = orient(p, q, b, c);
+  const double s2 = orient(p, q, c, a);
+  return (s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0);
+}
+
+}  // namespace
+
+bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
+                         const Vec3& b1, const Vec3& b2) {
+  // Two triangles that cross meet in a segment whose ends lie on edges; so some edge of one
+  // pierces the other.
+  return segment_crosses(a0, a1, b0, b1, b2) || segment_crosses(a1, a2, b0, b1, b2) ||
+         segment_crosses(a2, a0, b0, b1, b2) || segment_crosses(b0, b1, a0, a1, a2) ||
+         segment_crosses(b1, b2, a0, a1, a2) || segment_crosses(b2, b0, a0, a1, a2);
+}
+
+struct IntersectionCounter::Impl {
+  const Topology& cloth;
+  detail::SeamLinks links;
+  std::optional<Topology> body;
+  Bvh cloth_bvh, body_bvh;
+  bool cloth_built = false, body_built = false;
+
+  Impl(const Topology& c, std::span<const StitchTerm> st, const std::vector<Face>& bf, int nb)
+      : cloth(c), links(c.num_vertices(), st) {
+    if (!bf.empty()) body.emplace(bf, nb);
+  }
+
+  [[nodiscard]] bool skip_self(int f, int g) const {
+    const Face& a = cloth.faces()[f];
+    const Face& b = cloth.faces()[g];
+    return links.any_linked(a, b);  // includes shared vertices
+  }
+  [[nodiscard]] static bool test(std::span<const Vec3> x, const Face& a, std::span<const Vec3> y,
+                                 const Face& b) {
+    return triangles_intersect(x[a[0]], x[a[1]], x[a[2]], y[b[0]], y[b[1]], y[b[2]]);
+  }
+};
+
+IntersectionCounter::IntersectionCounter(const Topology& cloth,
+                                         std::span<const StitchTerm> stitches,
+                                         const std::vector<Face>& body_faces, int body_vertices)
+    : impl_(std::make_unique<Impl>(cloth, stitches, body_faces, body_vertices)) {}
+IntersectionCounter::~IntersectionCounter() = default;
+
+std::vector<std::pair<int, int>> IntersectionCounter::self_pairs(std::span<const Vec3> x) {
+  Impl& im = *impl_;
+  if (!im.cloth_built) {
+    im.cloth_bvh = Bvh(im.cloth, x, BvhBuild::Spatial);
+    im.cloth_built = true;
+  }
+  RefitOptions ro;
+  ro.cones = false;
+  im.cloth_bvh.refit(x, ro);
+  std::vector<std::pair<int, int>> out;
+  const auto& faces = im.cloth.faces();
+  detail::for_each_self_overlap(im.cloth_bvh, [&](int f, int g) {
+    if (im.skip_self(f, g)) return;
+    if (Impl::test(x, faces[f], x, faces[g])) out.emplace_back(std::min(f, g), std::max(f, g));
+  });
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::pair<int, int>> IntersectionCounter::body_pairs(std::span<const Vec3> x,
+                                                                 std::span<const Vec3> body) {
+  Impl& im = *impl_;
+  std::vector<std::pair<int, int>> out;
+  if (!im.body) return out;
+  if (!im.cloth_built) {
+    im.cloth_bvh = Bvh(im.cloth, x, BvhBuild::Spatial);
+    im.cloth_built = true;
+  }
+  if (!im.body_built) {
+    im.body_bvh = Bvh(*im.body, body, BvhBuild::Spatial);
+    im.body_built = true;
+  }
+  RefitOptions ro;
+  ro.cones = false;
+  im.cloth_bvh.refit(x, ro);
+  im.body_bvh.refit(body, ro);
+  const auto& cf = im.cloth.faces();
+  const auto& bf = im.body->faces();
+  detail::for_each_overlap(im.cloth_bvh, im.body_bvh, [&](int f, int g) {
+    if (Impl::test(x, cf[f], body, bf[g])) out.emplace_back(f, g);
+  });
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::pair<int, int>> IntersectionCounter::self_pairs_brute_force(
+    std::span<const Vec3> x) const {
+  const Impl& im = *impl_;
+  std::vector<std::pair<int, int>> out;
+  const auto& faces = im.cloth.faces();
+  for (int f = 0; f < im.cloth.num_faces(); ++f) {
+    for (int g = f + 1; g < im.cloth.num_faces(); ++g) {
+      if (!im.skip_self(f, g) && Impl::test(x, faces[f], x, faces[g])) out.emplace_back(f, g);
+    }
+  }
+  return out;
+}
+
+std::vector<std::pair<int, int>> IntersectionCounter::body_pairs_brute_force(
+    std::span<const Vec3> x, std::span<const Vec3> body) const {
+  const Impl& im = *impl_;
+  std::vector<std::pair<int, int>> out;
+  if (!im.body) return out;
+  const auto& cf = im.cloth.faces();
+  const auto& bf = im.body->faces();
+  for (int f = 0; f < im.cloth.num_faces(); ++f) {
+    for (int g = 0; g < im.body->num_faces(); ++g) {
+      if (Impl::test(x, cf[f], body, bf[g])) out.emplace_back(f, g);
+    }
+  }
+  return out;
+}
+
+}  // namespace clothcd::sim
