@@ -50,7 +50,9 @@ def ordered(values, preferred):
 
 
 def fig5(spread, out):
-    scenes = [s for s in dict.fromkeys(r["scene"] for r in spread)]
+    # A one-step scene makes no curve: the tables carry it.
+    scenes = [s for s in dict.fromkeys(r["scene"] for r in spread)
+              if len({r["step"] for r in spread if r["scene"] == s}) >= 3]
     builds = ordered({r["build"] for r in spread}, ["spatial", "patch"])
     if not scenes:
         return False
@@ -67,9 +69,12 @@ def fig5(spread, out):
                 if not pts:
                     continue
                 xs, ys = zip(*pts)
-                ax.plot(xs, ys, "-", color=COLORS.get(policy, "k"), label=policy,
-                        marker="o" if policy == "OPTIMAL" or len(xs) < 12 else None, markersize=3,
-                        linewidth=2.2 if policy == "OPTIMAL" else 1.4)
+                # EXACT dashed so PROPOSED stays visible where they coincide; OPTIMAL is only
+                # computed on some steps: markers joined by a dotted line.
+                style = {"EXACT": "--", "OPTIMAL": ":"}.get(policy, "-")
+                ax.plot(xs, ys, style, color=COLORS.get(policy, "k"), label=policy,
+                        marker="o" if policy == "OPTIMAL" or len(xs) < 12 else None, markersize=3.5,
+                        linewidth=2.0 if policy == "OPTIMAL" else 1.4)
             ax.set_title("%s, %s build: node %s (depth %s)" % (scene, build, node, depth), fontsize=9)
             ax.set_xlabel("CD call (step)")
             ax.set_ylabel("spread angle (deg)")
@@ -82,7 +87,8 @@ def fig5(spread, out):
 
 
 def fig6(steps, out):
-    scenes = [s for s in dict.fromkeys(r["scene"] for r in steps)]
+    scenes = [s for s in dict.fromkeys(r["scene"] for r in steps)
+              if len({r["step"] for r in steps if r["scene"] == s}) >= 3]
     cullings = ordered({r["culling"] for r in steps if r["culling"] != "none"}, ["cone", "gated", "sound"])
     if not scenes or not cullings:
         return False

@@ -87,7 +87,45 @@ class Bar {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-Sequence resolve_scene(const std::string& s, const Args& a) {
+int parse_count(const std::string& text, const std::string& spec, int min) {
+  if (text.empty() || text.size() > 6 ||
+      text.find_first_not_of("0123456789") != std::string::npos || std::stoi(text) < min) {
+    throw InputError(fmt::format(
+        "--scene '{}': expected NAME@STEPS or NAME@FIRST:STEPS (STEPS >= 1, FIRST >= 0)", spec));
+  }
+  return std::stoi(text);
+}
+
+Sequence resolve_scene_range(const std::string& s, const Args& a);
+
+// `NAME@N`: at most N CD calls for that scene (overrides --steps); `NAME@F:N`: the N calls from
+// frame F on (the frames before F are simulated or read, then dropped).
+Sequence resolve_scene(const std::string& spec, const Args& args) {
+  const auto at = spec.rfind('@');
+  if (at == std::string::npos) return resolve_scene_range(spec, args);
+  Args a = args;
+  const std::string range = spec.substr(at + 1);
+  int first = 0;
+  if (const auto colon = range.find(':'); colon != std::string::npos) {
+    first = parse_count(range.substr(0, colon), spec, 0);
+    a.steps = first + parse_count(range.substr(colon + 1), spec, 1);
+  } else {
+    a.steps = parse_count(range, spec, 1);
+  }
+  Sequence q = resolve_scene_range(spec.substr(0, at), a);
+  if (first > 0) {
+    if (first + 1 >= static_cast<int>(q.frames.size())) {
+      throw InputError(fmt::format("--scene '{}': only {} frames", spec, q.frames.size()));
+    }
+    q.frames.erase(q.frames.begin(), q.frames.begin() + first);
+    // Another window is another scene: its results must not be reused for this one.
+    q.name += fmt::format("-from{}", first);
+    q.source += fmt::format(", from frame {}: step k = frames {}+k -> {}+k+1", first, first, first);
+  }
+  return q;
+}
+
+Sequence resolve_scene_range(const std::string& s, const Args& a) {
   const int max_frames = a.steps >= 0 ? a.steps + 1 : -1;
   std::string proc = s.starts_with("proc:") ? s.substr(5) : s;
   for (const auto& n : procedural_names()) {
@@ -216,7 +254,9 @@ const bool registered = clothcd::app::register_command(
       sub.add_option("--scene", a->scenes,
                      "folder of frames, scene name (scenes/NAME.json, simulated into "
                      "OUT/frames/NAME), scene .json file, cloth_ball, or a procedural sequence "
-                     "(fold, stacked_sheets, winding_strip, crumpled_sheet, twisted_strip)")
+                     "(fold, stacked_sheets, winding_strip, crumpled_sheet, twisted_strip); "
+                     "NAME@N: at most N "
+                     "CD calls for that scene")
           ->required();
       sub.add_option("--out", a->out, "output folder (results found there are reused)")->required();
       sub.add_option("--steps", a->steps, "at most this many CD calls (frame pairs) per scene")

@@ -316,8 +316,10 @@ std::string misses(const std::vector<SceneData>& data, const ExperimentOptions& 
 std::string spread_table(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
   std::string s =
       "# Spread angles (degrees)\n\n"
+      "Every column is a mean over the steps on which OPTIMAL cones were computed (every "
+      "`--optimal-every` steps; *steps* says how many). "
       "*node*: the tracked node of fig5 (mid depth, non-saturated PROVOT cone at the first "
-      "step; the median such angle), mean over the steps where it was computed. *vs OPTIMAL*: "
+      "step; the median such angle). *vs OPTIMAL*: "
       "on the steps with OPTIMAL cones (every `--optimal-every` steps), the mean half-angle over "
       "the internal nodes whose OPTIMAL cone is not saturated, divided by OPTIMAL's mean there. "
       "*internal mean*: over all internal nodes, saturated cones counted as 90.\n\n";
@@ -341,6 +343,8 @@ std::string spread_table(const std::vector<SceneData>& data, const ExperimentOpt
         int id = -1, depth = -1;
         for (const auto& r : d.spread) {
           if (r.build != build_name(b) || r.policy != p) continue;
+          // Only the OPTIMAL steps, when there are any, so every column compares like with like.
+          if (!opt_mean.empty() && !opt_mean.contains(r.step)) continue;
           id = r.node;
           depth = r.node_depth;
           node.push_back(r.node_angle);
