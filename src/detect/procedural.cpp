@@ -2,9 +2,14 @@
 
 #include <Eigen/Geometry>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
+
+#include <fmt/format.h>
+
+#include "clothcd/core/error.hpp"
 
 namespace clothcd {
 namespace {
@@ -149,6 +154,48 @@ ProceduralScene twisted_strip(int segments, int width) {
     }
   }
   return s;
+}
+
+Positions smooth_perturbation(const Positions& positions, double amplitude, double wavelength,
+                              std::uint64_t seed) {
+  if (!(amplitude >= 0) || !std::isfinite(amplitude) || !(wavelength > 0) ||
+      !std::isfinite(wavelength)) {
+    throw InputError(fmt::format(
+        "perturbation: amplitude must be >= 0 and wavelength > 0 (finite), got {} and {}",
+        amplitude, wavelength));
+  }
+  if (positions.cols() != 3) {
+    throw InputError(
+        fmt::format("perturbation: positions must be n x 3, got {} columns", positions.cols()));
+  }
+  // Our own uniform conversion (not std::uniform_real_distribution) so that the field is the same
+  // with every standard library.
+  std::mt19937_64 rng(seed);
+  auto uniform = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
+  struct Wave {
+    Eigen::Vector3d k;
+    double phase;
+  };
+  std::array<std::array<Wave, 3>, 3> waves;
+  const double k = 2 * kPi / wavelength;
+  for (auto& comp : waves) {
+    for (auto& w : comp) {
+      const double z = 2 * uniform() - 1, phi = 2 * kPi * uniform();
+      const double r = std::sqrt(1 - z * z);
+      w = {k * Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z), 2 * kPi * uniform()};
+    }
+  }
+  Positions out = positions;
+  for (Eigen::Index i = 0; i < positions.rows(); ++i) {
+    const Eigen::Vector3d x = positions.row(i).transpose();
+    for (int c = 0; c < 3; ++c) {
+      double d = 0;
+      for (const Wave& w : waves[c])
+        d += std::sin(w.k.dot(x) + w.phase);
+      out(i, c) += amplitude * d / 3.0;  // |d| <= 3
+    }
+  }
+  return out;
 }
 
 }  // namespace clothcd

@@ -35,4 +35,11 @@ struct ProceduralScene {
 /// A strip `segments` x `width` quads, twisted and coiled so that its ends cross.
 [[nodiscard]] ProceduralScene twisted_strip(int segments = 80, int width = 4);
 
+/// `positions` plus a smooth displacement field: per coordinate, a sum of three plane waves of
+/// the given wavelength (random directions and phases from `seed`), scaled so that no coordinate
+/// moves by more than `amplitude`. Neighbouring vertices move almost alike, so a mesh keeps its
+/// shape (e.g. a draped garment stepped to a nearby pose). Deterministic for a seed.
+[[nodiscard]] Positions smooth_perturbation(const Positions& positions, double amplitude,
+                                            double wavelength, std::uint64_t seed);
+
 }  // namespace clothcd
