@@ -240,8 +240,11 @@ std::vector<int> grid_edge(ObjectReader& p, const std::string& which, const Grid
 
 }  // namespace
 
-int SubstepRule::count(double body_displacement) const {
-  const double n = std::ceil(body_displacement / displacement);
+int SubstepRule::count(double body_displacement, double cloth_displacement_estimate) const {
+  double n = std::ceil(body_displacement / displacement);
+  if (cloth_displacement > 0) {
+    n = std::max(n, std::ceil(cloth_displacement_estimate / cloth_displacement));
+  }
   if (!(n >= min)) return min;  // also NaN
   return n > max ? max : static_cast<int>(n);
 }
@@ -312,6 +315,8 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     s.substeps.min = o.integer("min", s.substeps.min, 1, 10000);
     s.substeps.max = o.integer("max", s.substeps.max, s.substeps.min, 10000);
     s.substeps.displacement = o.number("displacement", s.substeps.displacement, 1e-9, 1e6);
+    s.substeps.cloth_displacement =
+        o.number("cloth_displacement", s.substeps.cloth_displacement, 0.0, 1e6);
     o.finish();
   }
   if (top.has("body")) {

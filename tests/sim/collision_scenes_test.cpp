@@ -19,6 +19,7 @@ json sphere_scene(int frames, int res) {
     "name": "small-sphere-drop", "frame_dt": 0.04,
     "cloth": {"grid": {"origin": [-0.3, 0.33, -0.3], "u": [0.6, 0, 0], "v": [0, 0, 0.6]}},
     "material": {"friction": 0.4},
+    "substeps": {"cloth_displacement": 0.004},
     "body": {"type": "sphere", "center": [0, 0, 0], "radius": 0.25, "subdivisions": 2,
              "spin_axis": [0, 1, 0], "spin_deg_per_s": 180, "spin_start": 0.3},
     "collisions": {"self": true, "body": true, "thickness": 0.001}
@@ -86,6 +87,7 @@ TEST(Simulation, StripFoldingOntoItselfStaysIntersectionFree) {
     "cloth": {"grid": {"origin": [0, 0.01, 0], "u": [0.05, 0, 0], "v": [0.2, 0.2, 0.0],
                        "resolution": [4, 30]}},
     "material": {"friction": 0.3},
+    "substeps": {"cloth_displacement": 0.004},
     "collisions": {"self": true, "body": true, "thickness": 0.001}
   })"),
                         "fold.json");

@@ -22,8 +22,14 @@ struct SubstepRule {
   int min = 4;
   int max = 32;
   double displacement = 0.04;  ///< one substep per this much body motion (m)
-  /// n = clamp(ceil(body displacement in the frame / displacement), min, max)
-  [[nodiscard]] int count(double body_displacement) const;
+  /// Also one substep per this much cloth motion, from the fastest cloth vertex at the frame's
+  /// start (0: off). With collisions, a vertex stopped by an impulse while its neighbour moves on
+  /// stretches their edge by the distance moved in one substep, so this keeps it below the edge
+  /// length.
+  double cloth_displacement = 0.0;
+  /// n = clamp(max(ceil(body displacement in the frame / displacement),
+  ///               ceil(cloth speed * frame time / cloth_displacement)), min, max)
+  [[nodiscard]] int count(double body_displacement, double cloth_displacement_estimate = 0.0) const;
 };
 
 struct Scene {
