@@ -14,6 +14,10 @@ constexpr int kMaxLevel = 10;
 // Ranges examined (with the inside test) per query; past it the inclusion solver takes the rest of
 // the step. Bounds the cost of flat cubics (near-coplanar motion) whose sign is never certain.
 constexpr int kBudget = 48;
+// The inside test (~45 ns) starts at this depth: the cubic's own halving (~5 ns) first discards the
+// quarters of the step without a root. On cloth_ball 92 -> 93 this halves the inside tests
+// (7.7 M -> 4.4 M for 2.3 M queries); deeper starts cost more on near-coplanar (flat) cubics.
+constexpr int kFirstInsideLevel = 2;
 // Subdivision error bounds hold to this depth.
 constexpr int kMaxRefine = 40;
 
@@ -75,6 +79,13 @@ FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
   int n = 0;
   stack[n++] = Node{{c.k[0], c.k[1], c.k[2], c.k[3]}, 0.0, 1.0, 0};
   int visited = 0;
+  auto split = [&](const Node& nd) {
+    const double mid = (nd.lo + nd.hi) * 0.5;
+    Node l{{}, nd.lo, mid, nd.level + 1}, r{{}, mid, nd.hi, nd.level + 1};
+    halve(nd.b, l.b, r.b);
+    stack[n++] = r;
+    stack[n++] = l;
+  };
   // Depth-first, earlier half on top: when a range is examined, every earlier time is settled
   // (no contact there), so the first contact found is the first contact of the step.
   while (n > 0) {
@@ -83,6 +94,10 @@ FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
     if (++visited > kBudget) {
       include(nd.lo, 1.0);
       return out;
+    }
+    if (nd.level < kFirstInsideLevel) {
+      split(nd);
+      continue;
     }
     double u = 0, v = 0;
     const Inside in = inside_over(data, nd.lo, nd.hi, u, v);
@@ -100,11 +115,7 @@ FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
       if (include(nd.lo, nd.hi)) return out;
       continue;
     }
-    const double mid = (nd.lo + nd.hi) * 0.5;
-    Node l{{}, nd.lo, mid, nd.level + 1}, r{{}, mid, nd.hi, nd.level + 1};
-    halve(nd.b, l.b, r.b);
-    stack[n++] = r;
-    stack[n++] = l;
+    split(nd);
   }
   return out;
 }

@@ -53,12 +53,14 @@ struct SelfDetector::Impl {
   std::vector<std::uint8_t> face_active, vertex_active, edge_active, node_active;
   // Per-step swept boxes of the features (storage reused across steps).
   std::vector<detail::Box> vboxes, eboxes, fboxes;
+  detail::Ownership owner;
 
   Impl(std::vector<Face> faces, int nv, const Positions& ref, const DetectOptions& o)
       : topo(std::move(faces), nv), opt(o) {
     detail::to_points(ref, nv, "reference shape", v0);
     bvh = Bvh(topo, v0, o.build);
     orphans = detail::find_orphans(topo);
+    owner = detail::Ownership(topo);
   }
 
   [[nodiscard]] bool cones_used(Culling mode) const {
@@ -182,38 +184,35 @@ struct SelfDetector::Impl {
   }
 
   // Tests the feature pairs of a non-adjacent triangle pair whose representative pair it is.
+  // Needs the context's precomputed boxes. Box test first (cheap, rejects most), then ownership.
   template <class Out, class KernelVf, class KernelEe>
   void triangle_pair(const detail::FeatureContext& ctx, int f, int g, Out& out, KernelVf&& kvf,
                      KernelEe&& kee) const {
     const Face& tf = topo.faces()[f];
     const Face& tg = topo.faces()[g];
-    const detail::Box bf = ctx.face_box(f), bg = ctx.face_box(g);
+    const detail::Box& bf = ctx.fboxes[f];
+    const detail::Box& bg = ctx.fboxes[g];
     for (int v : tf) {
-      if (!detail::overlap(ctx.vertex_box(v), bg)) continue;
-      if (detail::vf_representative(topo, v, g) != f || !vf_in_scope(v, g)) continue;
+      if (!detail::overlap(ctx.vboxes[v], bg)) continue;
+      if (!owner.owns_vf(v, g, f) || !vf_in_scope(v, g)) continue;
       kvf(v, g, out);
     }
     for (int v : tg) {
-      if (!detail::overlap(ctx.vertex_box(v), bf)) continue;
-      if (detail::vf_representative(topo, v, f) != g || !vf_in_scope(v, f)) continue;
+      if (!detail::overlap(ctx.vboxes[v], bf)) continue;
+      if (!owner.owns_vf(v, f, g) || !vf_in_scope(v, f)) continue;
       kvf(v, f, out);
     }
     const auto& ef = topo.face_edges(f);
     const auto& eg = topo.face_edges(g);
-    std::array<detail::Box, 3> bxf, bxg;
-    for (int k = 0; k < 3; ++k) {
-      bxf[k] = ctx.edge_box(ef[k]);
-      bxg[k] = ctx.edge_box(eg[k]);
-    }
     for (int i = 0; i < 3; ++i) {
+      const detail::Box& ba = ctx.eboxes[ef[i]];
+      if (!detail::overlap(ba, bg)) continue;  // edge of f misses all of g
       for (int j = 0; j < 3; ++j) {
-        if (!detail::overlap(bxf[i], bxg[j])) continue;
+        if (!detail::overlap(ba, ctx.eboxes[eg[j]])) continue;
         const int ea = ef[i], eb = eg[j];
         const bool a_first = ea < eb;
         const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;
-        const auto rep = detail::ee_representative(topo, e1, e2);
-        const bool mine =
-            a_first ? (rep.first == f && rep.second == g) : (rep.first == g && rep.second == f);
+        const bool mine = a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f);
         if (!mine || !ee_in_scope(e1, e2)) continue;
         kee(e1, e2, out);
       }

@@ -18,28 +18,45 @@
 
 namespace clothcd::detail {
 
+/// Swept box of a feature, stored in float (half the memory traffic of the narrow phase, whose
+/// box tests are memory-bound), rounded outwards so it still contains the double box.
 struct Box {
-  Eigen::Vector3d lo, hi;
+  float lo[3], hi[3];
 };
 
+inline float round_down(double x) {
+  const float f = static_cast<float>(x);
+  return f > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+inline float round_up(double x) {
+  const float f = static_cast<float>(x);
+  return f < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
 inline Box swept_box(std::initializer_list<const Eigen::Vector3d*> pts, double margin) {
-  Box b{Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()),
-        Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity())};
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
   for (const Eigen::Vector3d* p : pts) {
-    b.lo = b.lo.cwiseMin(*p);
-    b.hi = b.hi.cwiseMax(*p);
+    lo = lo.cwiseMin(*p);
+    hi = hi.cwiseMax(*p);
   }
   if (margin > 0) {
     for (int k = 0; k < 3; ++k) {
-      b.lo[k] = std::nextafter(b.lo[k] - margin, -std::numeric_limits<double>::infinity());
-      b.hi[k] = std::nextafter(b.hi[k] + margin, std::numeric_limits<double>::infinity());
+      lo[k] = std::nextafter(lo[k] - margin, -std::numeric_limits<double>::infinity());
+      hi[k] = std::nextafter(hi[k] + margin, std::numeric_limits<double>::infinity());
     }
+  }
+  Box b;
+  for (int k = 0; k < 3; ++k) {
+    b.lo[k] = round_down(lo[k]);
+    b.hi[k] = round_up(hi[k]);
   }
   return b;
 }
 
 inline bool overlap(const Box& a, const Box& b) {
-  return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
+  return a.lo[0] <= b.hi[0] && a.lo[1] <= b.hi[1] && a.lo[2] <= b.hi[2] && b.lo[0] <= a.hi[0] &&
+         b.lo[1] <= a.hi[1] && b.lo[2] <= a.hi[2];
 }
 
 inline bool share_vertex(const Face& a, const Face& b) {
@@ -171,6 +188,61 @@ inline std::pair<int, int> ee_representative(const Topology& topo, int ea, int e
   }
   return {-1, -1};
 }
+
+/// The same R-triangle ownership answers as vf_representative / ee_representative, over flat
+/// copies of the adjacency (no out-of-line calls in the narrow phase's hot loop), for a triangle
+/// pair (f, g) that shares no vertex (the traversal drops the others).
+class Ownership {
+ public:
+  Ownership() = default;
+  explicit Ownership(const Topology& topo) : faces_(topo.faces().data()) {
+    flatten(
+        topo.num_vertices(), [&](int v) { return topo.vertex_faces(v); }, vf_off_, vf_ids_);
+    flatten(
+        topo.num_edges(), [&](int e) { return topo.edge_faces(e); }, ef_off_, ef_ids_);
+  }
+
+  /// Whether f (a face of v, sharing no vertex with g) is the R-triangle of (v, g): every face of
+  /// v before it touches g.
+  [[nodiscard]] bool owns_vf(int v, int g, int f) const {
+    const Face& tg = faces_[g];
+    for (int i = vf_off_[v]; i < vf_off_[v + 1]; ++i) {
+      const int h = vf_ids_[i];
+      if (h == f) return true;
+      if (!share_vertex(faces_[h], tg)) return false;
+    }
+    return false;
+  }
+
+  /// Whether (x, y) (x a face of e1, y of e2, sharing no vertex) is the first non-adjacent face
+  /// pair of (e1, e2) in ee_representative's order.
+  [[nodiscard]] bool owns_ee(int e1, int e2, int x, int y) const {
+    for (int i = ef_off_[e1]; i < ef_off_[e1 + 1]; ++i) {
+      const int fa = ef_ids_[i];
+      for (int j = ef_off_[e2]; j < ef_off_[e2 + 1]; ++j) {
+        const int fb = ef_ids_[j];
+        if (fa == x && fb == y) return true;
+        if (!share_vertex(faces_[fa], faces_[fb])) return false;
+      }
+    }
+    return false;
+  }
+
+ private:
+  template <class Get>
+  static void flatten(int n, Get&& get, std::vector<int>& off, std::vector<int>& ids) {
+    off.assign(n + 1, 0);
+    ids.clear();
+    for (int i = 0; i < n; ++i) {
+      const auto span = get(i);
+      ids.insert(ids.end(), span.begin(), span.end());
+      off[i + 1] = static_cast<int>(ids.size());
+    }
+  }
+
+  const Face* faces_ = nullptr;
+  std::vector<int> vf_off_, vf_ids_, ef_off_, ef_ids_;
+};
 
 inline bool vf_less(const VertexFaceCollision& a, const VertexFaceCollision& b) {
   return a.vertex < b.vertex || (a.vertex == b.vertex && a.face < b.face);
