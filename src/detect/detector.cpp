@@ -90,7 +90,9 @@ struct SelfDetector::Impl {
       if (!(k.half_angle < std::numbers::pi / 2 - kConeMargin)) return false;
       if (mode != Culling::Sound) return true;
       ++c.contour_tests;
-      const bool ok = detail::contour_star_shaped(bvh.contour(i), v0, v1, k.axis);
+      // The star test is O(contour); the general simplicity test catches what it cannot.
+      const bool ok = detail::contour_star_shaped(bvh.contour(i), v0, v1, k.axis) ||
+                      detail::contour_simple(bvh.contour(i), v0, v1, k.axis);
       if (!ok) ++c.contour_fails;
       return ok;
     };
