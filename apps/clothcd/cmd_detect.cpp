@@ -1,9 +1,11 @@
 // `clothcd detect --t0 FILE --t1 FILE ...`: continuous self-collision detection over one step
-// between two frames with the same topology; prints a summary and optionally writes JSON.
+// between two frames with the same topology (or t0 and a smooth perturbation of it); prints a
+// summary and optionally writes JSON, or a table of every build, culling mode and policy.
 #include <fmt/format.h>
 #include <tbb/global_control.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -13,6 +15,7 @@
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/sewing.hpp"
 #include "command.hpp"
@@ -25,9 +28,12 @@ using namespace clothcd;
 struct Args {
   std::string t0, t1, json;
   std::string policy = "proposed", culling = "none", bvh = "spatial";
-  double weld = 0, thickness = 0;
+  double weld = 0, sew = 0, thickness = 0;
+  double perturb = 0, wavelength = 0.2;
+  std::uint64_t seed = 1;
+  int garment_vertices = -1;
   int threads = 0;
-  bool verify = false;
+  bool verify = false, table = false, table_optimal = false;
 };
 
 nlohmann::json stats_json(const DetectStats& s) {
@@ -74,10 +80,116 @@ T pick(const std::string& name, const std::string& value, const std::map<std::st
   return it->second;
 }
 
-int run(const Args& a) {
+// The two frames of the step: --t1, or t0 plus a smooth perturbation; optionally cut to the
+// garment prefix of a drape.obj (its first N vertices and the faces that use only them).
+std::pair<TriangleMesh, TriangleMesh> load_frames(const Args& a) {
+  if (a.t1.empty() == (a.perturb <= 0)) {
+    throw InputError("give exactly one of --t1 FILE and --perturb AMPLITUDE (> 0)");
+  }
   TriangleMesh m0 = read_mesh(a.t0);
-  TriangleMesh m1 = read_mesh(a.t1);
-  check_same_topology(m0, a.t0, m1, a.t1);
+  TriangleMesh m1;
+  if (!a.t1.empty()) {
+    m1 = read_mesh(a.t1);
+    check_same_topology(m0, a.t0, m1, a.t1);
+  }
+  if (a.garment_vertices >= 0) {
+    int nf = 0;
+    while (nf < m0.num_faces()) {
+      const Face& t = m0.faces[nf];
+      if (std::max({t[0], t[1], t[2]}) >= a.garment_vertices) break;
+      ++nf;
+    }
+    m0 = submesh_prefix(m0, a.garment_vertices, nf);
+    if (!a.t1.empty()) m1 = submesh_prefix(m1, a.garment_vertices, nf);
+    fmt::print("garment prefix: {} vertices, {} faces\n", m0.num_vertices(), m0.num_faces());
+  }
+  if (a.perturb > 0) {
+    m1 = m0;
+    const Positions p = smooth_perturbation(vertices_matrix(m0), a.perturb, a.wavelength, a.seed);
+    for (int i = 0; i < m1.num_vertices(); ++i)
+      m1.vertices[i] = p.row(i).transpose();
+    fmt::print("t1 = t0 + smooth perturbation (amplitude {}, wavelength {}, seed {})\n", a.perturb,
+               a.wavelength, a.seed);
+  }
+  return {std::move(m0), std::move(m1)};
+}
+
+// One row of --table: a configuration and its result.
+struct Row {
+  const char* bvh;
+  const char* culling;
+  const char* policy;
+  DetectResult r;
+};
+
+std::size_t missed_against(const DetectResult& none, const DetectResult& r) {
+  std::vector<VertexFaceCollision> vf;
+  std::vector<EdgeEdgeCollision> ee;
+  auto vf_key = [](const VertexFaceCollision& x, const VertexFaceCollision& y) {
+    return std::pair(x.vertex, x.face) < std::pair(y.vertex, y.face);
+  };
+  auto ee_key = [](const EdgeEdgeCollision& x, const EdgeEdgeCollision& y) {
+    return std::pair(x.edge_a, x.edge_b) < std::pair(y.edge_a, y.edge_b);
+  };
+  std::set_difference(none.vf.begin(), none.vf.end(), r.vf.begin(), r.vf.end(),
+                      std::back_inserter(vf), vf_key);
+  std::set_difference(none.ee.begin(), none.ee.end(), r.ee.begin(), r.ee.end(),
+                      std::back_inserter(ee), ee_key);
+  return vf.size() + ee.size();
+}
+
+// Every build x culling mode x policy on one step, as a markdown table (misses and culled pairs
+// against `none` of the same build).
+void print_table(const TriangleMesh& w0, const TriangleMesh& w1, double thickness,
+                 bool with_optimal) {
+  const Positions p0 = vertices_matrix(w0), p1 = vertices_matrix(w1);
+  const std::pair<const char*, BvhBuild> builds[] = {{"spatial", BvhBuild::Spatial},
+                                                     {"patch", BvhBuild::Patch}};
+  const std::pair<const char*, Culling> modes[] = {
+      {"cone", Culling::Cone}, {"gated", Culling::Gated}, {"sound", Culling::Sound}};
+  const std::pair<const char*, ConePolicy> policies[] = {{"PROVOT", ConePolicy::Provot},
+                                                         {"PROPOSED", ConePolicy::Proposed},
+                                                         {"EXACT", ConePolicy::Exact},
+                                                         {"OPTIMAL", ConePolicy::Optimal}};
+  fmt::print(
+      "\n| bvh | culling | policy | connected / disk internal nodes | triangle pairs | pairs "
+      "culled "
+      "vs none | nodes culled | contour fails | VF / EE tests | collisions | missed vs none | "
+      "refit / traverse / narrow (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const auto& [bname, build] : builds) {
+    DetectOptions o;
+    o.build = build;
+    o.thickness = thickness;
+    SelfDetector det(w0.faces, w0.num_vertices(), p0, o);
+    const DetectResult none = det.detect(p0, p1);
+    std::vector<Row> rows;
+    rows.push_back({bname, "none", "-", none});
+    for (const auto& [mname, mode] : modes) {
+      for (const auto& [pname, policy] : policies) {
+        if (policy == ConePolicy::Optimal && !with_optimal) continue;
+        o.culling = mode;
+        o.policy = policy;
+        det.set_options(o);
+        rows.push_back({bname, mname, pname, det.detect(p0, p1)});
+      }
+    }
+    for (const Row& row : rows) {
+      const DetectStats& s = row.r.stats;
+      const double culled = 100.0 * (double(none.stats.triangle_pairs) - double(s.triangle_pairs)) /
+                            std::max<double>(1.0, double(none.stats.triangle_pairs));
+      fmt::print(
+          "| {} | {} | {} | {:.2f}% / {:.2f}% | {} | {:.2f}% | {} | {} | {} / {} | {} | {} | "
+          "{:.3f} / {:.3f} / {:.3f} |\n",
+          row.bvh, row.culling, row.policy, 100 * s.connected_share(),
+          100.0 * s.disk_internal_nodes / std::max(1, s.internal_nodes), s.triangle_pairs, culled,
+          s.nodes_culled, s.contour_fails, s.vf_tests, s.ee_tests,
+          row.r.vf.size() + row.r.ee.size(), missed_against(none, row.r), s.time_refit,
+          s.time_traverse, s.time_narrow);
+    }
+  }
+}
+
+int run(const Args& a) {
   DetectOptions o;
   o.policy = pick<ConePolicy>("policy", a.policy,
                               {{"provot", ConePolicy::Provot},
@@ -92,16 +204,20 @@ int run(const Args& a) {
   o.build =
       pick<BvhBuild>("bvh", a.bvh, {{"spatial", BvhBuild::Spatial}, {"patch", BvhBuild::Patch}});
   if (!(a.thickness >= 0)) throw InputError("--thickness must be >= 0");
+  if (a.weld > 0 && a.sew > 0) throw InputError("give at most one of --weld and --sew");
+  if (a.table && !a.json.empty()) throw InputError("--table writes no JSON; drop --json");
   o.thickness = a.thickness;
   o.verify = a.verify;
+  const auto [m0, m1] = load_frames(a);
 
   // Original id of each detector vertex (the smallest original id of a welded cluster).
   std::vector<int> original(m0.num_vertices());
   for (int i = 0; i < m0.num_vertices(); ++i)
     original[i] = i;
   TriangleMesh w0 = m0, w1 = m1;
-  if (a.weld > 0) {
-    SewnMesh sewn = weld(m0, a.weld);
+  if (a.weld > 0 || a.sew > 0) {
+    // Sewing also splits T-junction edges at existing vertices, so the vertex map stays valid.
+    SewnMesh sewn = a.sew > 0 ? sew(m0, a.sew) : weld(m0, a.weld);
     w0 = sewn.mesh;
     original.assign(w0.num_vertices(), -1);
     for (int i = static_cast<int>(sewn.vertex_map.size()) - 1; i >= 0; --i) {
@@ -110,27 +226,35 @@ int run(const Args& a) {
     w1 = w0;
     for (int n = 0; n < w0.num_vertices(); ++n)
       w1.vertices[n] = m1.vertices[original[n]];
-    fmt::print("welded {} vertices ({} -> {}), {} faces dropped, components {} -> {}\n",
-               sewn.report.vertices_welded, m0.num_vertices(), w0.num_vertices(),
-               sewn.report.faces_dropped, sewn.report.components_before,
-               sewn.report.components_after);
+    const SewingReport& rep = sewn.report;
+    fmt::print(
+        "{} {} vertices ({} -> {}), {} edges split, {} faces dropped, components {} -> {}, "
+        "non-manifold edges {} -> {}\n",
+        a.sew > 0 ? "sewn: welded" : "welded", rep.vertices_welded, m0.num_vertices(),
+        w0.num_vertices(), rep.edges_split, rep.faces_dropped, rep.components_before,
+        rep.components_after, rep.nonmanifold_edges_before, rep.nonmanifold_edges_after);
   }
   std::optional<tbb::global_control> threads;
   if (a.threads > 0) {
     threads.emplace(tbb::global_control::max_allowed_parallelism,
                     static_cast<std::size_t>(a.threads));
   }
+  if (a.table) {
+    print_table(w0, w1, a.thickness, a.table_optimal);
+    return 0;
+  }
   SelfDetector det(w0.faces, w0.num_vertices(), vertices_matrix(w0), o);
   const DetectResult r = det.detect(vertices_matrix(w0), vertices_matrix(w1));
   const DetectStats& s = r.stats;
   fmt::print(
-      "{} triangles, bvh {} ({:.1f}% edge-connected internal nodes), policy {}, culling {}\n"
-      "triangle pairs {}, nodes culled {}, VF tests {} (NP culled {}), EE tests {} (NP culled "
-      "{})\ncollisions: {} VF, {} EE\ntime: refit {:.4f} s, traversal {:.4f} s, narrow phase "
-      "{:.4f} s\n",
-      w0.num_faces(), a.bvh, 100 * s.connected_share(), a.policy, a.culling, s.triangle_pairs,
-      s.nodes_culled, s.vf_tests, s.vf_np_culled, s.ee_tests, s.ee_np_culled, r.vf.size(),
-      r.ee.size(), s.time_refit, s.time_traverse, s.time_narrow);
+      "{} triangles, bvh {} ({:.1f}% edge-connected, {:.1f}% disk internal nodes), policy {}, "
+      "culling {}\ntriangle pairs {}, nodes culled {}, VF tests {} (NP culled {}), EE tests {} "
+      "(NP culled {})\ncollisions: {} VF, {} EE\ntime: refit {:.4f} s, traversal {:.4f} s, "
+      "narrow phase {:.4f} s\n",
+      w0.num_faces(), a.bvh, 100 * s.connected_share(),
+      100.0 * s.disk_internal_nodes / std::max(1, s.internal_nodes), a.policy, a.culling,
+      s.triangle_pairs, s.nodes_culled, s.vf_tests, s.vf_np_culled, s.ee_tests, s.ee_np_culled,
+      r.vf.size(), r.ee.size(), s.time_refit, s.time_traverse, s.time_narrow);
   if (r.verified) {
     fmt::print(
         "verify: {} VF and {} EE collisions missed against culling none ({} triangle "
@@ -173,14 +297,26 @@ const bool registered = clothcd::app::register_command(
     [](CLI::App& sub) {
       auto a = std::make_shared<Args>();
       sub.add_option("--t0", a->t0, "frame at the start of the step")->required();
-      sub.add_option("--t1", a->t1, "frame at the end of the step (same topology)")->required();
+      sub.add_option("--t1", a->t1, "frame at the end of the step (same topology)");
+      sub.add_option("--perturb", a->perturb,
+                     "instead of --t1: step to t0 plus a smooth perturbation of this amplitude");
+      sub.add_option("--wavelength", a->wavelength, "wavelength of the perturbation (0.2)");
+      sub.add_option("--seed", a->seed, "seed of the perturbation (1)");
+      sub.add_option("--garment-vertices", a->garment_vertices,
+                     "keep the first N vertices and the faces using only them (a drape.obj "
+                     "garment)");
       sub.add_option("--policy", a->policy, "cone policy: provot|proposed|exact|optimal");
       sub.add_option("--culling", a->culling, "culling: none|cone|gated|sound");
       sub.add_option("--bvh", a->bvh, "BVH build: spatial|patch");
       sub.add_option("--weld", a->weld, "weld vertices closer than this first (0: off)");
+      sub.add_option("--sew", a->sew, "weld and conform T-junctions at this tolerance (0: off)");
       sub.add_option("--thickness", a->thickness, "contact distance (>= 0)");
       sub.add_option("--threads", a->threads, "worker threads (0: all)");
       sub.add_flag("--verify", a->verify, "also run culling none and report missed collisions");
+      sub.add_flag("--table", a->table,
+                   "print a table of every BVH build, culling mode and cone policy instead");
+      sub.add_flag("--table-optimal", a->table_optimal,
+                   "include the OPTIMAL policy in --table (slow: minutes per refit on garments)");
       sub.add_option("--json", a->json, "write collisions and statistics to this JSON file");
       return [a] { return run(*a); };
     });
