@@ -8,6 +8,9 @@
 #include <numeric>
 #include <optional>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "bvh_pairs.hpp"
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/ccd/proximity.hpp"
@@ -240,38 +243,81 @@ struct ContactHandler::Impl {
       std::vector<std::pair<int, int>> vf_cb, vf_bc, ee;
       const auto& cf = model.topology().faces();
       const auto& bf = body_topo->faces();
+      const auto& ce = model.topology().edges();
+      const auto& be = body_topo->edges();
+      // Feature boxes grown by d-hat prune most candidates of an overlapping face pair.
+      auto near = [dh](const Vec3& lo_a, const Vec3& hi_a, const Vec3& lo_b, const Vec3& hi_b) {
+        return (lo_a.array() <= hi_b.array() + dh).all() &&
+               (lo_b.array() <= hi_a.array() + dh).all();
+      };
+      auto box = [](std::span<const Vec3> x, std::initializer_list<int> ids, Vec3& lo, Vec3& hi) {
+        lo = Vec3::Constant(INFINITY);
+        hi = Vec3::Constant(-INFINITY);
+        for (int i : ids) {
+          lo = lo.cwiseMin(x[i]);
+          hi = hi.cwiseMax(x[i]);
+        }
+      };
       detail::for_each_overlap(cloth_bvh, body_bvh, [&](int f, int g) {
-        for (int v : cf[f])
-          vf_cb.emplace_back(v, g);
-        for (int u : bf[g])
-          vf_bc.emplace_back(u, f);
+        Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
+        box(x0, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
+        box(b0, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
+        for (int v : cf[f]) {
+          if (near(x0[v], x0[v], glo, ghi)) vf_cb.emplace_back(v, g);
+        }
+        for (int u : bf[g]) {
+          if (near(b0[u], b0[u], flo, fhi)) vf_bc.emplace_back(u, f);
+        }
         for (int a : model.topology().face_edges(f)) {
-          for (int b : body_topo->face_edges(g))
-            ee.emplace_back(a, b);
+          box(x0, {ce[a][0], ce[a][1]}, lo, hi);
+          for (int b : body_topo->face_edges(g)) {
+            box(b0, {be[b][0], be[b][1]}, lo2, hi2);
+            if (near(lo, hi, lo2, hi2)) ee.emplace_back(a, b);
+          }
         }
       });
       for (auto* l : {&vf_cb, &vf_bc, &ee}) {
         std::sort(l->begin(), l->end());
         l->erase(std::unique(l->begin(), l->end()), l->end());
       }
-      for (const auto& [v, g] : vf_cb) {
+      // Distances in parallel into flags; contacts are then built in the sorted order.
+      auto within = [&](const std::vector<std::pair<int, int>>& l, auto&& dist) {
+        std::vector<std::uint8_t> keep(l.size(), 0);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, l.size(), 512),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                            for (std::size_t i = r.begin(); i != r.end(); ++i)
+                              keep[i] = dist(l[i].first, l[i].second) <= dh ? 1 : 0;
+                          });
+        return keep;
+      };
+      const auto k_cb = within(vf_cb, [&](int v, int g) {
         const Face& t = bf[g];
-        if (point_triangle_proximity(x0[v], b0[t[0]], b0[t[1]], b0[t[2]]).distance > dh) continue;
-        Contact c;
-        if (make_vf(c, v, false, g, true, 0.0, none)) proximity.push_back(c);
-      }
-      for (const auto& [u, f] : vf_bc) {
+        return point_triangle_proximity(x0[v], b0[t[0]], b0[t[1]], b0[t[2]]).distance;
+      });
+      const auto k_bc = within(vf_bc, [&](int u, int f) {
         const Face& t = cf[f];
-        if (point_triangle_proximity(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]).distance > dh) continue;
+        return point_triangle_proximity(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]).distance;
+      });
+      const auto k_ee = within(ee, [&](int a, int b) {
+        return edge_edge_proximity(x0[ce[a][0]], x0[ce[a][1]], b0[be[b][0]], b0[be[b][1]]).distance;
+      });
+      for (std::size_t i = 0; i < vf_cb.size(); ++i) {
         Contact c;
-        if (make_vf(c, u, true, f, false, 0.0, none)) proximity.push_back(c);
+        if (k_cb[i] && make_vf(c, vf_cb[i].first, false, vf_cb[i].second, true, 0.0, none)) {
+          proximity.push_back(c);
+        }
       }
-      for (const auto& [a, b] : ee) {
-        const Edge& x = model.topology().edges()[a];
-        const Edge& y = body_topo->edges()[b];
-        if (edge_edge_proximity(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]]).distance > dh) continue;
+      for (std::size_t i = 0; i < vf_bc.size(); ++i) {
         Contact c;
-        if (make_ee(c, a, false, b, true, 0.0, none)) proximity.push_back(c);
+        if (k_bc[i] && make_vf(c, vf_bc[i].first, true, vf_bc[i].second, false, 0.0, none)) {
+          proximity.push_back(c);
+        }
+      }
+      for (std::size_t i = 0; i < ee.size(); ++i) {
+        Contact c;
+        if (k_ee[i] && make_ee(c, ee[i].first, false, ee[i].second, true, 0.0, none)) {
+          proximity.push_back(c);
+        }
       }
     }
   }
@@ -390,6 +436,8 @@ struct ContactHandler::Impl {
     UnionFind uf(n);
     std::vector<std::uint8_t> in_zone(n, 0);
     std::vector<std::pair<int, Vec3>> anchors;  // cloth vertex, velocity it must follow
+    std::vector<Vec3> vertex_anchor_sum(n, Vec3::Zero());
+    std::vector<int> vertex_anchor_count(n, 0);
     std::vector<int> active = faces_of(changed);
     const auto& mass = model.mass();
     for (int round = 0;; ++round) {
@@ -438,9 +486,13 @@ struct ContactHandler::Impl {
       }
       std::vector<Vec3> anchor_sum(members.size(), Vec3::Zero());
       std::vector<int> anchor_count(members.size(), 0);
+      std::fill(vertex_anchor_sum.begin(), vertex_anchor_sum.end(), Vec3::Zero());
+      std::fill(vertex_anchor_count.begin(), vertex_anchor_count.end(), 0);
       for (const auto& [i, vel] : anchors) {
         anchor_sum[zone_of[i]] += vel;
         ++anchor_count[zone_of[i]];
+        vertex_anchor_sum[i] += vel;
+        ++vertex_anchor_count[i];
       }
       std::fill(changed.begin(), changed.end(), 0);
       st.zones = static_cast<int>(members.size());
@@ -455,9 +507,34 @@ struct ContactHandler::Impl {
           }
         }
         if (anchor_count[z] > 0) {
-          const Vec3 target = anchor_sum[z] / anchor_count[z];
+          // Each vertex follows the body point it touches; the others follow their nearest
+          // anchored zone member (the mean of all anchors when the zone is very large).
+          std::vector<int> anchored;
           for (int i : m) {
-            if (inv_mass[i] != 0.0) v[i] = target;
+            if (vertex_anchor_count[i] > 0 || inv_mass[i] == 0.0) anchored.push_back(i);
+          }
+          auto anchor_of = [&](int j) {
+            return inv_mass[j] == 0.0 ? v[j] : Vec3(vertex_anchor_sum[j] / vertex_anchor_count[j]);
+          };
+          const bool small = static_cast<double>(m.size()) * anchored.size() < 1e6;
+          const Vec3 mean = anchor_sum[z] / anchor_count[z];
+          std::vector<Vec3> target(m.size());
+          for (std::size_t k = 0; k < m.size(); ++k) {
+            const int i = m[k];
+            if (vertex_anchor_count[i] > 0) {
+              target[k] = anchor_of(i);
+            } else if (small && !anchored.empty()) {
+              int best = anchored[0];
+              for (int j : anchored) {
+                if ((x0[j] - x0[i]).squaredNorm() < (x0[best] - x0[i]).squaredNorm()) best = j;
+              }
+              target[k] = anchor_of(best);
+            } else {
+              target[k] = mean;
+            }
+          }
+          for (std::size_t k = 0; k < m.size(); ++k) {
+            if (inv_mass[m[k]] != 0.0) v[m[k]] = target[k];
           }
           continue;
         }
