@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
-# Sets up, builds and runs every test: the Release suite (unit, data, slow, install), a format
-# check, then the unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer.
+# Sets up, builds and runs every test: the Release suite (unit, data, slow, install, cli) with gcc
+# and a format check; then one clang tree with AddressSanitizer + UndefinedBehaviorSanitizer that
+# holds both the unit tests (run again there) and the libFuzzer targets (library objects built with
+# -fsanitize=fuzzer-no-link), each fuzzed briefly on its seed corpus. Fails on any failure.
 # Data-driven tests read CLOTHCD_DATA (default ../shared/data) and skip when it is absent.
+# CLOTHCD_FUZZ_SECONDS (default 12) bounds each fuzz target's run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 jobs=$(nproc)
+start=$SECONDS
 
 echo "== Release build"
 cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -14,10 +18,17 @@ cmake --build build/release --target format-check
 echo "== Release tests"
 ctest --test-dir build/release --output-on-failure -j "$jobs"
 
-echo "== Sanitizer build (ASan + UBSan)"
-cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLOTHCD_SANITIZE=ON \
-  -DCLOTHCD_BUILD_BENCH=OFF -DCLOTHCD_BUILD_APPS=OFF >/dev/null
+echo "== Sanitizer + fuzzer build (clang, ASan + UBSan)"
+# A tree configured with another compiler cannot switch in place.
+if [ -f build/asan/CMakeCache.txt ] && ! grep -q '^CMAKE_CXX_COMPILER:FILEPATH=.*clang' build/asan/CMakeCache.txt; then
+  rm -rf build/asan
+fi
+CXX=clang++ cmake -S . -B build/asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCLOTHCD_SANITIZE=ON \
+  -DCLOTHCD_FUZZ=ON -DCLOTHCD_BUILD_BENCH=OFF >/dev/null
 cmake --build build/asan -j "$jobs"
 echo "== Sanitizer unit tests"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build/asan --output-on-failure -j "$jobs" -L unit
+echo "== Fuzzing (${CLOTHCD_FUZZ_SECONDS:-12} s per target)"
+scripts/fuzz.sh --build-dir build/asan --no-build "${CLOTHCD_FUZZ_SECONDS:-12}"
+echo "== All tests passed in $((SECONDS - start)) s"

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "atomic_json.hpp"
 #include "clothcd/ccd/query_csv.hpp"
 #include "clothcd/core/error.hpp"
 #include "command.hpp"
@@ -44,18 +45,6 @@ nlohmann::json to_json(const Row& r, bool with_path) {
   j["false_positives"] = r.fp;
   j["seconds"] = r.seconds;
   return j;
-}
-
-void write_json_atomically(const fs::path& file, const nlohmann::json& j) {
-  fs::path tmp = file;
-  tmp += ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw clothcd::input_error(tmp.string(), 0, "cannot write file");
-    out << j.dump(2) << '\n';
-    if (!out) throw clothcd::input_error(tmp.string(), 0, "write failed");
-  }
-  fs::rename(tmp, file);
 }
 
 struct Args {
@@ -149,7 +138,7 @@ int run(const Args& args) {
     for (const auto& r : rows)
       j["files"].push_back(to_json(r, true));
     j["total"] = to_json(total, false);
-    write_json_atomically(args.json, j);
+    clothcd::app::write_json_atomically(args.json, j, 2);
   }
   if (total.fn > 0) {
     fmt::print(stderr, "clothcd: {} false negative(s)\n", total.fn);

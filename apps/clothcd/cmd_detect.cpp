@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "atomic_json.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/procedural.hpp"
@@ -59,18 +60,6 @@ nlohmann::json stats_json(const DetectStats& s) {
           {"time_refit", s.time_refit},
           {"time_traverse", s.time_traverse},
           {"time_narrow", s.time_narrow}};
-}
-
-void write_atomically(const fs::path& file, const nlohmann::json& j) {
-  fs::path tmp = file;
-  tmp += ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw input_error(tmp.string(), 0, "cannot write file");
-    out << j.dump(1) << '\n';
-    if (!out) throw input_error(tmp.string(), 0, "write failed");
-  }
-  fs::rename(tmp, file);
 }
 
 template <class T>
@@ -287,7 +276,7 @@ int run(const Args& a) {
       j["missed_vf"] = vf_json(r.missed_vf);
       j["missed_ee"] = ee_json(r.missed_ee);
     }
-    write_atomically(a.json, j);
+    clothcd::app::write_json_atomically(a.json, j, 1);
   }
   return 0;
 }

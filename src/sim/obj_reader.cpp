@@ -4,7 +4,9 @@
 #include <fmt/format.h>
 
 #include <charconv>
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -52,6 +54,10 @@ struct LineParser {
     if (ec != std::errc() || p != t.data() + t.size()) {
       throw input_error(file.string(), line,
                         fmt::format("expected a number for {}, got '{}'", what, t));
+    }
+    // from_chars reads "nan" and "inf"; a non-finite position would poison the whole solve.
+    if (!std::isfinite(v)) {
+      throw input_error(file.string(), line, fmt::format("{} '{}' is not finite", what, t));
     }
     return v;
   }
@@ -126,9 +132,20 @@ ObjData read_obj(const std::filesystem::path& file) {
       }
     } else if (key == "stitch") {
       Stitch st;
-      st.a = static_cast<int>(lp.integer(lp.token(), "stitch vertex"));
-      st.b = static_cast<int>(lp.integer(lp.token(), "stitch vertex"));
-      st.c = static_cast<int>(lp.integer(lp.token(), "stitch vertex"));
+      // Checked before narrowing, so 2^32 + 1 is not read as vertex 1 (the range check against
+      // the vertex count comes after the whole file is read).
+      auto vertex = [&] {
+        const std::string_view t = lp.token();
+        const long v = lp.integer(t, "stitch vertex");
+        if (v < 0 || v > std::numeric_limits<int>::max()) {
+          throw input_error(file.string(), line,
+                            fmt::format("stitch vertex {} is not a 0-based vertex id", t));
+        }
+        return static_cast<int>(v);
+      };
+      st.a = vertex();
+      st.b = vertex();
+      st.c = vertex();
       st.r = lp.number("stitch ratio");
       d.stitches.push_back(st);
     }
