@@ -29,16 +29,21 @@ inline double max_abs(const V3& a) {
 
 }  // namespace
 
-BernsteinCubic coplanarity_cubic(Kind kind, const Motion& m) {
+namespace {
+
+// x0[k], x1[k]: the four points at t = 0 and t = 1 in motion order. Also returns A, the largest
+// |component| of the computed differences.
+BernsteinCubic cubic_of(Kind kind, const Eigen::Vector3d* const* x0,
+                        const Eigen::Vector3d* const* x1, double& a) {
   // Point indices of a, b, c, q in the motion's order.
   const int ia = kind == Kind::vertex_face ? 1 : 0;
   const int ib = kind == Kind::vertex_face ? 2 : 1;
   const int ic = kind == Kind::vertex_face ? 3 : 2;
   const int iq = kind == Kind::vertex_face ? 0 : 3;
-  const V3 e1_0 = sub(m.x0[ib], m.x0[ia]), e2_0 = sub(m.x0[ic], m.x0[ia]);
-  const V3 r0 = sub(m.x0[iq], m.x0[ia]);
-  const V3 e1_1 = sub(m.x1[ib], m.x1[ia]), e2_1 = sub(m.x1[ic], m.x1[ia]);
-  const V3 r1 = sub(m.x1[iq], m.x1[ia]);
+  const V3 e1_0 = sub(*x0[ib], *x0[ia]), e2_0 = sub(*x0[ic], *x0[ia]);
+  const V3 r0 = sub(*x0[iq], *x0[ia]);
+  const V3 e1_1 = sub(*x1[ib], *x1[ia]), e2_1 = sub(*x1[ic], *x1[ia]);
+  const V3 r1 = sub(*x1[iq], *x1[ia]);
   const V3 n0 = cross(e1_0, e2_0), n1 = cross(e1_1, e2_1);
   const V3 c01 = cross(e1_0, e2_1), c10 = cross(e1_1, e2_0);
   // 2 nX = e1_0 x e2_1 + e1_1 x e2_0 (the better-conditioned form of the middle control vector).
@@ -53,10 +58,33 @@ BernsteinCubic coplanarity_cubic(Kind kind, const Motion& m) {
   // middle ones before the division), reached through at most ~12 roundings plus the relative
   // error u of each difference factor: below 100 u A^3. 256 leaves margin for rounding A^3
   // itself; the absolute term covers underflow (inputs are scaled so that |x| < 1).
-  const double a = std::max(
+  a = std::max(
       {max_abs(e1_0), max_abs(e2_0), max_abs(r0), max_abs(e1_1), max_abs(e2_1), max_abs(r1)});
   c.eta = 256 * kUnitRoundoff * (a * a * a) + 1024 * std::numeric_limits<double>::denorm_min();
   return c;
+}
+
+}  // namespace
+
+BernsteinCubic coplanarity_cubic(Kind kind, const Motion& m) {
+  const Eigen::Vector3d* x0[4] = {&m.x0[0], &m.x0[1], &m.x0[2], &m.x0[3]};
+  const Eigen::Vector3d* x1[4] = {&m.x1[0], &m.x1[1], &m.x1[2], &m.x1[3]};
+  double a = 0;
+  return cubic_of(kind, x0, x1, a);
+}
+
+bool unscaled_np_culls(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points) {
+  for (const Eigen::Vector3d* p : points) {
+    if (!p->allFinite()) return false;
+  }
+  double a = 0;
+  const BernsteinCubic c = cubic_of(kind, points.data(), points.data() + 4, a);
+  // Without the rescaling the same bound holds while nothing overflows (A <= 2^100: every
+  // intermediate stays below ~2^305) and underflow stays negligible: each underflowing rounding
+  // adds at most denorm_min / 2, grown by at most two later factors <= 2^101, so below 2^-968 in
+  // all, while the bound's slack (256 - 100) u A^3 is at least 2^-946 for A >= 2^-300.
+  constexpr double kLow = 0x1p-300, kHigh = 0x1p100;
+  return a >= kLow && a <= kHigh && np_culls(c);
 }
 
 bool np_culls(const BernsteinCubic& c) {

@@ -53,6 +53,12 @@ CcdResult from(const ccd_detail::InclusionOutcome& o, CcdPath path, std::uint32_
 CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
               const CcdOptions& opt) {
   check_options(opt);
+  // Most pairs of a detection step end here: the NP filter without building the scaled motion.
+  if (opt.fast_path && opt.thickness == 0 && ccd_detail::unscaled_np_culls(kind, points)) {
+    CcdResult r;
+    r.path = CcdPath::np_culled;
+    return r;
+  }
   const Motion m = ccd_detail::make_motion(points);
   const double max_coord = m.max_abs.maxCoeff() / m.scale;
   // Any two of the points are within 2 sqrt(3) max|x| < 4 max|x|: contact from the start. This
@@ -108,11 +114,13 @@ CcdResult edge_edge_ccd(const EdgeEdgeQuery& q, const CcdOptions& opt) {
 }
 
 bool np_filter_culls(const VertexFaceQuery& q) {
+  if (ccd_detail::unscaled_np_culls(Kind::vertex_face, points_of(q))) return true;
   return ccd_detail::np_culls(
       ccd_detail::coplanarity_cubic(Kind::vertex_face, ccd_detail::make_motion(points_of(q))));
 }
 
 bool np_filter_culls(const EdgeEdgeQuery& q) {
+  if (ccd_detail::unscaled_np_culls(Kind::edge_edge, points_of(q))) return true;
   return ccd_detail::np_culls(
       ccd_detail::coplanarity_cubic(Kind::edge_edge, ccd_detail::make_motion(points_of(q))));
 }
