@@ -1,18 +1,21 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target for a bounded time on its seed corpus (fuzz/corpus/<target>/) and
 # fails on any crash, sanitizer report, leak or timeout.
-# Usage: scripts/fuzz.sh [--build-dir DIR] [--no-build] [SECONDS_PER_TARGET] [TARGET...]
+# Usage: scripts/fuzz.sh [--build-dir DIR] [--no-build] [--jobs N] [SECONDS_PER_TARGET] [TARGET...]
 #   default: builds the targets with clang (ASan + UBSan) in build/fuzz, 20 s per target.
 #   scripts/test.sh uses `--build-dir build/asan --no-build`: its sanitizer tree already holds them.
+#   --jobs N runs N targets at a time (each target is one single-threaded process).
 # New inputs go to DIR/fuzz-corpus/<target>/, crashes to DIR/fuzz-crashes/, logs to DIR/fuzz-logs/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build/fuzz
 do_build=1
+parallel=1
 while [ $# -gt 0 ]; do
   case "$1" in
     --build-dir) build=$2; shift 2 ;;
     --no-build) do_build=0; shift ;;
+    --jobs) parallel=$2; shift 2 ;;
     *) break ;;
   esac
 done
@@ -31,12 +34,10 @@ if [ ${#targets[@]} -eq 0 ]; then
   mapfile -t targets < <(cd "$build/fuzz" && ls fuzz_* | grep -v '\.' | sort)
 fi
 mkdir -p "$build/fuzz-crashes" "$build/fuzz-logs"
-status=0
-for t in "${targets[@]}"; do
+fuzz_one() {
+  local t=$1 seeds="fuzz/corpus/$1" log="$build/fuzz-logs/$1.log"
   mkdir -p "$build/fuzz-corpus/$t"
-  seeds="fuzz/corpus/$t"
   [ -d "$seeds" ] || seeds=""
-  log="$build/fuzz-logs/$t.log"
   # -timeout: one input running 10 s is a hang; -rss_limit_mb: a claimed count must not allocate.
   if ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
      "$build/fuzz/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
@@ -45,7 +46,22 @@ for t in "${targets[@]}"; do
     execs=$(grep -m1 'stat::number_of_executed_units' "$log" | awk '{print $2}')
     echo "fuzz $t: ok, ${execs:-?} executions in ${seconds}s"
   else
-    echo "fuzz $t: FAILED (log $log, input in $build/fuzz-crashes/)"; tail -40 "$log"; status=1
+    echo "fuzz $t: FAILED (log $log, input in $build/fuzz-crashes/)"; tail -40 "$log"; return 1
   fi
+}
+
+status=0
+running=0
+for t in "${targets[@]}"; do
+  if [ "$running" -ge "$parallel" ]; then
+    wait -n || status=1
+    running=$((running - 1))
+  fi
+  fuzz_one "$t" &
+  running=$((running + 1))
+done
+while [ "$running" -gt 0 ]; do
+  wait -n || status=1
+  running=$((running - 1))
 done
 exit $status
