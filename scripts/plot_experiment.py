@@ -52,7 +52,7 @@ def ordered(values, preferred):
 def fig5(spread, out):
     # A one-step scene makes no curve: the tables carry it.
     scenes = [s for s in dict.fromkeys(r["scene"] for r in spread)
-              if len({r["step"] for r in spread if r["scene"] == s}) >= 3]
+              if len({r["step"] for r in spread if r["scene"] == s}) >= 2]
     builds = ordered({r["build"] for r in spread}, ["spatial", "patch"])
     if not scenes:
         return False
@@ -76,6 +76,7 @@ def fig5(spread, out):
                         marker="o" if policy == "OPTIMAL" or len(xs) < 12 else None, markersize=3.5,
                         linewidth=2.0 if policy == "OPTIMAL" else 1.4)
             ax.set_title("%s, %s build: node %s (depth %s)" % (scene, build, node, depth), fontsize=9)
+            ax.xaxis.get_major_locator().set_params(integer=True)
             ax.set_xlabel("CD call (step)")
             ax.set_ylabel("spread angle (deg)")
             ax.grid(alpha=0.3)
@@ -88,7 +89,7 @@ def fig5(spread, out):
 
 def fig6(steps, out):
     scenes = [s for s in dict.fromkeys(r["scene"] for r in steps)
-              if len({r["step"] for r in steps if r["scene"] == s}) >= 3]
+              if len({r["step"] for r in steps if r["scene"] == s}) >= 2]
     cullings = ordered({r["culling"] for r in steps if r["culling"] != "none"}, ["cone", "gated", "sound"])
     if not scenes or not cullings:
         return False
@@ -104,16 +105,23 @@ def fig6(steps, out):
                 if r["culling"] in (culling, "none"):
                     key = ("none", r["build"]) if r["culling"] == "none" else (r["policy"], r["build"])
                     series[key].append((int(r["step"]), float(r["triangle_pairs"])))
-            for build in builds:
-                for policy in ["none", "PROVOT", "PROPOSED", "EXACT"]:
+            for bi, build in enumerate(builds):
+                # EXACT first, wide and pale, so PROPOSED stays visible on top where they coincide;
+                # the reference does not depend on the build: drawn once.
+                for policy in ["none", "EXACT", "PROVOT", "PROPOSED"]:
+                    if policy == "none" and bi > 0:
+                        continue
                     pts = sorted(series.get((policy, build), []))
                     if not pts:
                         continue
                     xs, ys = zip(*pts)
                     ax.plot(xs, ys, "--" if policy == "none" else STYLES.get(build, "-"),
                             color="0.6" if policy == "none" else COLORS[policy],
-                            label="%s %s" % ("none (reference)" if policy == "none" else policy, build),
-                            marker="o" if len(xs) < 12 else None, markersize=3, linewidth=1.3)
+                            label="none (reference)" if policy == "none" else "%s %s" % (policy, build),
+                            marker="o" if len(xs) < 12 else None, markersize=3,
+                            linewidth=3.2 if policy == "EXACT" else 1.3,
+                            alpha=0.45 if policy == "EXACT" else 1.0)
+            ax.xaxis.get_major_locator().set_params(integer=True)
             ax.set_title("%s, culling %s" % (scene, culling), fontsize=9)
             ax.set_xlabel("CD call (step)")
             ax.set_ylabel("triangle pair tests")
