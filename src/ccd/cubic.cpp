@@ -73,9 +73,9 @@ BernsteinCubic coplanarity_cubic(Kind kind, const Motion& m) {
   return cubic_of(kind, x0, x1, a);
 }
 
-bool unscaled_np_culls(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points) {
+NpVerdict unscaled_np_filter(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points) {
   for (const Eigen::Vector3d* p : points) {
-    if (!p->allFinite()) return false;
+    if (!p->allFinite()) return NpVerdict::undecided;
   }
   double a = 0;
   const BernsteinCubic c = cubic_of(kind, points.data(), points.data() + 4, a);
@@ -84,7 +84,8 @@ bool unscaled_np_culls(Kind kind, const std::array<const Eigen::Vector3d*, 8>& p
   // adds at most denorm_min / 2, grown by at most two later factors <= 2^101, so below 2^-968 in
   // all, while the bound's slack (256 - 100) u A^3 is at least 2^-946 for A >= 2^-300.
   constexpr double kLow = 0x1p-300, kHigh = 0x1p100;
-  return a >= kLow && a <= kHigh && np_culls(c);
+  if (!(a >= kLow && a <= kHigh)) return NpVerdict::undecided;
+  return np_culls(c) ? NpVerdict::culled : NpVerdict::kept;
 }
 
 bool np_culls(const BernsteinCubic& c) {

@@ -16,9 +16,11 @@ struct BernsteinCubic {
 BernsteinCubic coplanarity_cubic(Kind kind, const Motion& m);
 
 /// The NP filter on the raw (unscaled) points, skipping the rescaling when the coordinate
-/// differences are within [2^-300, 2^100] (where the same error bound holds). False when it cannot
-/// cull or cannot decide (out of range, non-finite input): then use the scaled path.
-bool unscaled_np_culls(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points);
+/// differences are within [2^-300, 2^100] (where the same error bound holds, and the scaled
+/// cubic, an exact power-of-two multiple, gives the same answer). `undecided` when out of range
+/// or on non-finite input: then use the scaled path.
+enum class NpVerdict { culled, kept, undecided };
+NpVerdict unscaled_np_filter(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points);
 
 /// True when every coefficient is provably of one sign: no root in [0, 1].
 bool np_culls(const BernsteinCubic& c);

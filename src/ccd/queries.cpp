@@ -54,7 +54,8 @@ CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
               const CcdOptions& opt) {
   check_options(opt);
   // Most pairs of a detection step end here: the NP filter without building the scaled motion.
-  if (opt.fast_path && opt.thickness == 0 && ccd_detail::unscaled_np_culls(kind, points)) {
+  if (opt.fast_path && opt.thickness == 0 &&
+      ccd_detail::unscaled_np_filter(kind, points) == ccd_detail::NpVerdict::culled) {
     CcdResult r;
     r.path = CcdPath::np_culled;
     return r;
@@ -114,13 +115,15 @@ CcdResult edge_edge_ccd(const EdgeEdgeQuery& q, const CcdOptions& opt) {
 }
 
 bool np_filter_culls(const VertexFaceQuery& q) {
-  if (ccd_detail::unscaled_np_culls(Kind::vertex_face, points_of(q))) return true;
+  const auto verdict = ccd_detail::unscaled_np_filter(Kind::vertex_face, points_of(q));
+  if (verdict != ccd_detail::NpVerdict::undecided) return verdict == ccd_detail::NpVerdict::culled;
   return ccd_detail::np_culls(
       ccd_detail::coplanarity_cubic(Kind::vertex_face, ccd_detail::make_motion(points_of(q))));
 }
 
 bool np_filter_culls(const EdgeEdgeQuery& q) {
-  if (ccd_detail::unscaled_np_culls(Kind::edge_edge, points_of(q))) return true;
+  const auto verdict = ccd_detail::unscaled_np_filter(Kind::edge_edge, points_of(q));
+  if (verdict != ccd_detail::NpVerdict::undecided) return verdict == ccd_detail::NpVerdict::culled;
   return ccd_detail::np_culls(
       ccd_detail::coplanarity_cubic(Kind::edge_edge, ccd_detail::make_motion(points_of(q))));
 }
