@@ -14,6 +14,7 @@
 #include "bvh_pairs.hpp"
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/ccd/proximity.hpp"
+#include "clothcd/ccd/queries.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "seam_links.hpp"
 
@@ -75,8 +76,7 @@ struct ContactHandler::Impl {
   ContactOptions opt;
   detail::SeamLinks links;
   std::optional<SelfDetector> self;
-  // Body: CCD through the pair detector; proximity through static BVHs of both meshes.
-  std::optional<PairDetector> body_ccd;
+  // Body: proximity and CCD through clothcd BVHs of both meshes (static, then swept boxes).
   std::optional<Topology> body_topo;
   Bvh cloth_bvh, body_bvh;
   std::vector<Contact> proximity;
@@ -85,7 +85,7 @@ struct ContactHandler::Impl {
   std::vector<Vec3> vb;
   std::span<const double> inv_mass;
   double h = 0.0;
-  Positions x0m, b0m, b1m;
+  Positions x0m;
 
   Impl(const ClothModel& m, const ContactOptions& o)
       : model(m), opt(o), links(m.num_vertices(), m.stitches()) {}
@@ -190,11 +190,6 @@ struct ContactHandler::Impl {
     if (body_topo) return;
     const int nb = static_cast<int>(ctx.body_t0.size());
     body_topo.emplace(*ctx.body_faces, nb);
-    DetectOptions o;
-    o.culling = Culling::None;
-    o.thickness = opt.ccd_thickness;
-    body_ccd.emplace(model.topology().faces(), model.num_vertices(), x0m, *ctx.body_faces, nb, b0m,
-                     o);
     cloth_bvh = Bvh(model.topology(), ctx.x0, BvhBuild::Spatial);
     body_bvh = Bvh(*body_topo, ctx.body_t0, BvhBuild::Spatial);
   }
@@ -233,7 +228,6 @@ struct ContactHandler::Impl {
       }
     }
     if (has_body(ctx)) {
-      b0m = to_matrix(b0);
       ensure_body(ctx);
       RefitOptions ro;
       ro.cones = false;
@@ -349,21 +343,129 @@ struct ContactHandler::Impl {
       }
     }
     if (has_body(ctx)) {
-      const PairDetectResult r = body_ccd->detect(x0m, x1m, b0m, b1m);
-      for (const auto& p : r.vf_a_on_b) {
-        Contact c;
-        if (make_vf(c, p.vertex, false, p.face, true, p.toi, v)) out.push_back(c);
-      }
-      for (const auto& p : r.vf_b_on_a) {
-        Contact c;
-        if (make_vf(c, p.vertex, true, p.face, false, p.toi, v)) out.push_back(c);
-      }
-      for (const auto& p : r.ee) {
-        Contact c;
-        if (make_ee(c, p.edge_a, false, p.edge_b, true, p.toi, v)) out.push_back(c);
-      }
+      body_hits(x1, v, out);
     }
     return out;
+  }
+
+  // Cloth-body CCD: swept BVHs of both meshes, feature pairs whose swept boxes overlap, a
+  // distance bound (a pair farther apart at t0 than both sides can move plus the separation
+  // cannot touch; resting contact is mostly this), then clothcd's conservative CCD kernels.
+  void body_hits(const std::vector<Vec3>& x1, std::span<const Vec3> v, std::vector<Contact>& out) {
+    const double sep = opt.ccd_thickness;
+    RefitOptions ro;
+    ro.cones = false;
+    ro.thickness = sep;
+    cloth_bvh.refit(x0, x1, ro);
+    body_bvh.refit(b0, b1, ro);
+    const auto& cf = model.topology().faces();
+    const auto& bf = body_topo->faces();
+    const auto& ce = model.topology().edges();
+    const auto& be = body_topo->edges();
+    std::vector<double> move_c(x0.size()), move_b(b0.size());
+    for (std::size_t i = 0; i < x0.size(); ++i)
+      move_c[i] = (x1[i] - x0[i]).norm();
+    for (std::size_t i = 0; i < b0.size(); ++i)
+      move_b[i] = (b1[i] - b0[i]).norm();
+    auto swept = [](std::span<const Vec3> a, std::span<const Vec3> b,
+                    std::initializer_list<int> ids, Vec3& lo, Vec3& hi) {
+      lo = Vec3::Constant(INFINITY);
+      hi = Vec3::Constant(-INFINITY);
+      for (int i : ids) {
+        lo = lo.cwiseMin(a[i]).cwiseMin(b[i]);
+        hi = hi.cwiseMax(a[i]).cwiseMax(b[i]);
+      }
+    };
+    auto near = [sep](const Vec3& lo_a, const Vec3& hi_a, const Vec3& lo_b, const Vec3& hi_b) {
+      return (lo_a.array() <= hi_b.array() + sep).all() &&
+             (lo_b.array() <= hi_a.array() + sep).all();
+    };
+    std::vector<std::pair<int, int>> vf_cb, vf_bc, ee;
+    const std::span<const Vec3> x1s = x1;
+    detail::for_each_overlap(cloth_bvh, body_bvh, [&](int f, int g) {
+      Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
+      swept(x0, x1s, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
+      swept(b0, b1, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
+      for (int i : cf[f]) {
+        swept(x0, x1s, {i}, lo, hi);
+        if (near(lo, hi, glo, ghi)) vf_cb.emplace_back(i, g);
+      }
+      for (int u : bf[g]) {
+        swept(b0, b1, {u}, lo, hi);
+        if (near(lo, hi, flo, fhi)) vf_bc.emplace_back(u, f);
+      }
+      for (int a : model.topology().face_edges(f)) {
+        swept(x0, x1s, {ce[a][0], ce[a][1]}, lo, hi);
+        for (int b : body_topo->face_edges(g)) {
+          swept(b0, b1, {be[b][0], be[b][1]}, lo2, hi2);
+          if (near(lo, hi, lo2, hi2)) ee.emplace_back(a, b);
+        }
+      }
+    });
+    for (auto* l : {&vf_cb, &vf_bc, &ee}) {
+      std::sort(l->begin(), l->end());
+      l->erase(std::unique(l->begin(), l->end()), l->end());
+    }
+    const CcdOptions co{sep};
+    auto run = [&](const std::vector<std::pair<int, int>>& l, auto&& test) {
+      std::vector<double> toi(l.size(), -1.0);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, l.size(), 256),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i)
+                            toi[i] = test(l[i].first, l[i].second);
+                        });
+      return toi;
+    };
+    const auto t_cb = run(vf_cb, [&](int i, int g) {
+      const Face& t = bf[g];
+      const double reach = move_c[i] + std::max({move_b[t[0]], move_b[t[1]], move_b[t[2]]}) + sep;
+      if (point_triangle_proximity(x0[i], b0[t[0]], b0[t[1]], b0[t[2]]).distance > reach) {
+        return -1.0;
+      }
+      const CcdResult r = vertex_face_ccd(
+          {x0[i], b0[t[0]], b0[t[1]], b0[t[2]], x1[i], b1[t[0]], b1[t[1]], b1[t[2]]}, co);
+      return r.hit ? r.toi : -1.0;
+    });
+    const auto t_bc = run(vf_bc, [&](int u, int f) {
+      const Face& t = cf[f];
+      const double reach = move_b[u] + std::max({move_c[t[0]], move_c[t[1]], move_c[t[2]]}) + sep;
+      if (point_triangle_proximity(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]).distance > reach) {
+        return -1.0;
+      }
+      const CcdResult r = vertex_face_ccd(
+          {b0[u], x0[t[0]], x0[t[1]], x0[t[2]], b1[u], x1[t[0]], x1[t[1]], x1[t[2]]}, co);
+      return r.hit ? r.toi : -1.0;
+    });
+    const auto t_ee = run(ee, [&](int a, int b) {
+      const Edge& x = ce[a];
+      const Edge& y = be[b];
+      const double reach =
+          std::max(move_c[x[0]], move_c[x[1]]) + std::max(move_b[y[0]], move_b[y[1]]) + sep;
+      if (edge_edge_proximity(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]]).distance > reach) {
+        return -1.0;
+      }
+      const CcdResult r = edge_edge_ccd(
+          {x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], x1[x[0]], x1[x[1]], b1[y[0]], b1[y[1]]}, co);
+      return r.hit ? r.toi : -1.0;
+    });
+    for (std::size_t i = 0; i < vf_cb.size(); ++i) {
+      Contact c;
+      if (t_cb[i] >= 0 && make_vf(c, vf_cb[i].first, false, vf_cb[i].second, true, t_cb[i], v)) {
+        out.push_back(c);
+      }
+    }
+    for (std::size_t i = 0; i < vf_bc.size(); ++i) {
+      Contact c;
+      if (t_bc[i] >= 0 && make_vf(c, vf_bc[i].first, true, vf_bc[i].second, false, t_bc[i], v)) {
+        out.push_back(c);
+      }
+    }
+    for (std::size_t i = 0; i < ee.size(); ++i) {
+      Contact c;
+      if (t_ee[i] >= 0 && make_ee(c, ee[i].first, false, ee[i].second, true, t_ee[i], v)) {
+        out.push_back(c);
+      }
+    }
   }
 
   // Faces incident to the flagged vertices.
@@ -382,7 +484,6 @@ struct ContactHandler::Impl {
     const int n = model.num_vertices();
     vb.assign(b0.size(), Vec3::Zero());
     if (has_body(ctx)) {
-      b1m = to_matrix(b1);
       for (std::size_t i = 0; i < b0.size(); ++i)
         vb[i] = (b1[i] - b0[i]) / h;
     }
