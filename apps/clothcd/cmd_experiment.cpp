@@ -33,6 +33,7 @@ struct Args {
   std::vector<std::string> builds{"spatial", "patch"};
   int threads = 0;
   int optimal_every = 10;
+  int optimal_max_faces = 0;
   bool no_plots = false;
   std::string python = "/usr/bin/python3";
   std::string plot_script;
@@ -195,6 +196,7 @@ int run(const Args& a) {
     throw InputError("--policies and --builds need at least one value");
   }
   opt.optimal_every = a.optimal_every;
+  opt.optimal_max_faces = a.optimal_max_faces;
   std::optional<tbb::global_control> limit;
   if (a.threads > 0) {
     limit.emplace(tbb::global_control::max_allowed_parallelism,
@@ -268,6 +270,9 @@ const bool registered = clothcd::app::register_command(
           ->check(CLI::PositiveNumber);
       sub.add_option("--optimal-every", a->optimal_every,
                      "OPTIMAL cones (spread angles only) on every K-th step, 0: never")
+          ->check(CLI::NonNegativeNumber);
+      sub.add_option("--optimal-max-faces", a->optimal_max_faces,
+                     "no OPTIMAL cones for scenes with more triangles than this (0: no limit)")
           ->check(CLI::NonNegativeNumber);
       sub.add_flag("--no-plots", a->no_plots, "skip fig5.png / fig6.png");
       sub.add_option("--python", a->python,

@@ -223,7 +223,9 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
         }
       }
       const bool need_none = !have.contains({step, "none", "-"});
-      const bool optimal_step = opt.optimal_every > 0 && step % opt.optimal_every == 0;
+      const bool optimal_step = opt.optimal_every > 0 && step % opt.optimal_every == 0 &&
+                                (opt.optimal_max_faces <= 0 ||
+                                 static_cast<int>(seq.faces.size()) <= opt.optimal_max_faces);
       bool need_spread = optimal_step && !have_spread.contains({step, "OPTIMAL"});
       for (ConePolicy p : opt.policies)
         need_spread = need_spread || !have_spread.contains({step, policy_name(p)});

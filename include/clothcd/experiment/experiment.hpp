@@ -33,6 +33,9 @@ struct ExperimentOptions {
   std::vector<BvhBuild> builds{BvhBuild::Spatial, BvhBuild::Patch};
   /// OPTIMAL cones are computed on steps 0, K, 2K, ... (0: never).
   int optimal_every = 10;
+  /// No OPTIMAL cones for sequences with more triangles than this (0: no limit): its refit has
+  /// no saturation shortcut and takes minutes on large, crumpled garments.
+  int optimal_max_faces = 0;
 };
 
 /// One CD call of one configuration. `policy` is "-" for the unculled reference (culling none).
