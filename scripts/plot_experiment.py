@@ -65,7 +65,9 @@ def fig5(spread, out):
             node = rows[0]["node"] if rows else "?"
             depth = rows[0]["node_depth"] if rows else "?"
             for policy in ordered({r["policy"] for r in rows}, ["PROVOT", "PROPOSED", "EXACT", "OPTIMAL"]):
-                pts = sorted((int(r["step"]), float(r["node_angle_deg"])) for r in rows if r["policy"] == policy)
+                # Saturated cones (>= 90 deg, stored larger by older runs) are drawn at 90.
+                pts = sorted((int(r["step"]), min(90.0, float(r["node_angle_deg"])))
+                             for r in rows if r["policy"] == policy)
                 if not pts:
                     continue
                 xs, ys = zip(*pts)
@@ -81,8 +83,9 @@ def fig5(spread, out):
             ax.set_ylabel("spread angle (deg)")
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7, loc="best")
-    fig.suptitle("Spread angle of one BVH node over the steps (cf. the paper's Figure 5)", fontsize=11)
-    fig.tight_layout()
+    fig.suptitle("Spread angle of one BVH node over the steps (cf. the paper's Figure 5); "
+                 "90 = saturated", fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
     save(fig, os.path.join(out, "fig5.png"))
     return True
 
@@ -129,7 +132,7 @@ def fig6(steps, out):
             ax.legend(fontsize=6, loc="best", ncol=2)
     fig.suptitle("Triangle pair tests per CD call (cf. the paper's Figure 6); solid: spatial build, "
                  "dotted: patch build", fontsize=11)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
     save(fig, os.path.join(out, "fig6.png"))
     return True
 

@@ -136,7 +136,8 @@ std::vector<SpreadRow> spreads(const Sequence& seq, BvhBuild build, int step, Bv
     r.step = step;
     r.node = node;
     r.node_depth = depth_of(bvh, node);
-    r.node_angle = kDeg * cones[node].half_angle;
+    // A saturated cone may store more than pi/2 (propagated saturation); it means "90 or more".
+    r.node_angle = cones[node].saturated() ? 90.0 : kDeg * cones[node].half_angle;
     double sum = 0, dsum = 0;
     int internal = 0, saturated = 0, dn = 0;
     for (std::size_t i = 0; i < nodes.size(); ++i) {
