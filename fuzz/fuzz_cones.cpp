@@ -21,8 +21,11 @@ bool finite(const NormalCone& c) {
   return c.axis.allFinite() && std::isfinite(c.half_angle);
 }
 
+// Both normalized with stableNorm first: a normal of a tiny triangle (components ~1e-160) has
+// subnormal squares, and norm() of its cross product with the axis is then off by 1e-4.
 double angle(const Vector3d& a, const Vector3d& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b));
+  const Vector3d ua = a / a.stableNorm(), ub = b / b.stableNorm();
+  return std::atan2(ua.cross(ub).norm(), ua.dot(ub));
 }
 
 // Points on the rim of `c`, checked against `outer` with a rounding allowance.
@@ -82,8 +85,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           const double m = std::max({a.lpNorm<Eigen::Infinity>(), b.lpNorm<Eigen::Infinity>(),
                                      cc.lpNorm<Eigen::Infinity>()});
           const double err = 64 * std::numeric_limits<double>::epsilon() * m * m;
-          if (!(n.norm() > 1e3 * err)) continue;
-          if (angle(c.axis, n) > c.half_angle + 1e-7 + 2 * err / n.norm()) std::abort();
+          const double len = n.stableNorm();
+          if (!(len > 1e3 * err)) continue;
+          if (angle(c.axis, n) > c.half_angle + 1e-7 + 2 * err / len) std::abort();
         }
       }
     } else {

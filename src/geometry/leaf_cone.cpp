@@ -29,10 +29,12 @@ double direction_error(double len, double err) {
   return std::asin(err / len);
 }
 
-// |v| without overflow of the squared norm (coordinates beyond ~1e75 square past 1e308).
+// |v| without overflow or underflow of the squared norm: coordinates beyond ~1e154 square past
+// 1e308, and below ~1e-150 their squares lose bits in subnormals (a fuzzed near-degenerate
+// triangle got a normal 1.0002 long, so its leaf cone missed the true normal).
 double safe_norm(const Eigen::Vector3d& v) {
   const double n = v.norm();
-  return std::isfinite(n) ? n : v.stableNorm();
+  return std::isfinite(n) && n > 1e-140 ? n : v.stableNorm();
 }
 
 // A saturated-or-final leaf cone: `theta` plus slack, clamped to the canonical saturated form.

@@ -1,6 +1,7 @@
 // Named degenerate cases of the cone algebra: each must give a saturated (or exact) cone and
 // never NaN; NaN or infinite input must throw std::invalid_argument.
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <limits>
@@ -68,6 +69,27 @@ TEST(ConeDegenerate, LeafConeTable) {
   // is at least 45 degrees wide for every policy.
   const NormalCone quarter = ccd_leaf_cone(o, x, y, o, x, z, LeafConePolicy::Exact);
   EXPECT_GE(quarter.half_angle, std::numbers::pi / 4);
+}
+
+// Found by fuzz_cones: at t1 the triangle's edges are ~1e-76 long, so the components of its
+// normal square into subnormals and a plain norm() is off by 2e-4 (the leaf cone's unit control
+// direction was 1.0002 long, and so was the fuzz check's angle). The direction is compared here
+// after an underflow-safe normalization.
+TEST(ConeDegenerate, TinyNormalAtOneEndIsContained) {
+  const Vector3d a0(4.4873686467715366e-88, 1000, -126.28322672022482),
+      b0(1000, 8.1149752486733226e-305, 4.4759381595361624e-88),
+      c0(6.900123458739809e-305, 1000, 1000),
+      a1(-5.3446876474542822e-76, -5.3446876474542822e-76, -5.344235473633789e-76),
+      b1(0, 1.3943992169173992e-306, 1.2444070650856668e-85), c1(0, 0, 0);
+  Vector3d n1 = (b1 - a1).cross(c1 - a1);
+  n1 /= n1.stableNorm();
+  for (auto policy : {LeafConePolicy::Tang, LeafConePolicy::Proposed, LeafConePolicy::Exact}) {
+    const NormalCone c = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, policy);
+    ASSERT_TRUE(well_formed(c));
+    if (c.saturated()) continue;
+    const double angle = std::atan2(c.axis.cross(n1).norm(), c.axis.dot(n1));
+    EXPECT_LE(angle, c.half_angle) << static_cast<int>(policy);
+  }
 }
 
 TEST(ConeDegenerate, MergeTable) {
