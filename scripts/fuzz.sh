@@ -5,6 +5,8 @@
 #   default: builds the targets with clang (ASan + UBSan) in build/fuzz, 20 s per target.
 #   scripts/test.sh uses `--build-dir build/asan --no-build`: its sanitizer tree already holds them.
 #   --jobs N runs N targets at a time (each target is one single-threaded process).
+#   CLOTHCD_FUZZ_SEED: libFuzzer's -seed (default 0 = random; test.sh fixes it so that a CI run
+#   explores the same inputs every time, up to how many fit in the time).
 # New inputs go to DIR/fuzz-corpus/<target>/, crashes to DIR/fuzz-crashes/, logs to DIR/fuzz-logs/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -40,7 +42,7 @@ fuzz_one() {
   [ -d "$seeds" ] || seeds=""
   # -timeout: one input running 10 s is a hang; -rss_limit_mb: a claimed count must not allocate.
   if ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-     "$build/fuzz/$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+     "$build/fuzz/$t" -max_total_time="$seconds" -seed="${CLOTHCD_FUZZ_SEED:-0}" -timeout=10 -rss_limit_mb=2048 \
        -print_final_stats=1 -artifact_prefix="$build/fuzz-crashes/$t-" \
        "$build/fuzz-corpus/$t" $seeds >"$log" 2>&1; then
     execs=$(grep -m1 'stat::number_of_executed_units' "$log" | awk '{print $2}')

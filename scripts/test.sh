@@ -30,5 +30,5 @@ echo "== Sanitizer unit tests"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build/asan --output-on-failure -j "$jobs" -L unit
 echo "== Fuzzing (${CLOTHCD_FUZZ_SECONDS:-12} s per target)"
-scripts/fuzz.sh --build-dir build/asan --no-build --jobs "$jobs" "${CLOTHCD_FUZZ_SECONDS:-12}"
+CLOTHCD_FUZZ_SEED=${CLOTHCD_FUZZ_SEED:-1} scripts/fuzz.sh --build-dir build/asan --no-build --jobs "$jobs" "${CLOTHCD_FUZZ_SECONDS:-12}"
 echo "== All tests passed in $((SECONDS - start)) s"
