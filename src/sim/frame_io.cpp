@@ -5,6 +5,7 @@
 
 #include <bit>
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -138,6 +139,23 @@ ClothState read_state(const std::filesystem::path& path, int num_vertices, int& 
     in.read(reinterpret_cast<char*>(v->data()), static_cast<std::streamsize>(n * sizeof(Vec3)));
   }
   if (!in) throw input_error(path.string(), 0, "state file is truncated");
+  // A damaged or foreign state must not restart a run from garbage.
+  if (f < 0 || f > 1000000000) {
+    throw input_error(path.string(), 0, fmt::format("state frame {} is out of range", f));
+  }
+  if (!std::isfinite(s.time)) throw input_error(path.string(), 0, "state time is not finite");
+  const char* names[] = {"position", "velocity", "warm start"};
+  int k = 0;
+  for (const std::vector<Vec3>* v : {&s.x, &s.v, &s.dv}) {
+    for (std::size_t i = 0; i < v->size(); ++i) {
+      if (!(*v)[i].allFinite()) {
+        throw input_error(
+            path.string(), 0,
+            fmt::format("{} of vertex {} is not finite (expected finite numbers)", names[k], i));
+      }
+    }
+    ++k;
+  }
   frame = static_cast<int>(f);
   return s;
 }

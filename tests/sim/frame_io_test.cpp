@@ -1,9 +1,12 @@
 // Atomic output, state round trip, and resume that matches a straight run bitwise.
 #include <gtest/gtest.h>
+
 #include <unistd.h>
 
 #include <fstream>
 #include <iterator>
+#include <limits>
+#include <string>
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/sim/frame_io.hpp"
@@ -52,6 +55,18 @@ TEST(FrameIo, StateRoundTripIsExact) {
   EXPECT_EQ(test::hash_positions(back.dv), test::hash_positions(sim.state().dv));
   EXPECT_EQ(back.time, sim.state().time);
   EXPECT_THROW((void)read_state(dir.path / "s.bin", 3, frame), InputError);
+
+  // A NaN velocity in the file is rejected, naming the vertex.
+  ClothState bad = sim.state();
+  bad.v[5].y() = std::numeric_limits<double>::quiet_NaN();
+  write_state_atomic(dir.path / "nan.bin", bad, 1);
+  try {
+    (void)read_state(dir.path / "nan.bin", sim.model().num_vertices(), frame);
+    ADD_FAILURE() << "NaN state accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("velocity of vertex 5 is not finite"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(FrameIo, AtomicWriteLeavesNoTemporaryAndReplacesWhole) {
