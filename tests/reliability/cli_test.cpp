@@ -250,6 +250,26 @@ TEST(CliSimulate, FullDiskLeavesNoPartialFile) {
   }
 }
 
+// The experiment harness writes every result through the same atomic writer: a full disk is
+// reported, leaves no temporary, and finished results of an earlier run survive unchanged.
+TEST(CliExperiment, FullDiskKeepsFinishedResults) {
+  CliScratch dir;
+  const std::string args = "experiment --scene fold@2 --out out --no-plots --threads 1";
+  const auto first = dir.run(args);
+  ASSERT_EQ(first.code, 0) << first.err;
+  const std::string steps = CliScratch::slurp(dir / "out/steps.csv");
+  ASSERT_GT(steps.size(), 1024u);  // over the 1 KiB limit below, so rewriting it must fail
+
+  const auto full =
+      dir.run("experiment --scene fold@3 --out out --no-plots --threads 1", kDiskFull);
+  EXPECT_NE(full.code, 0);
+  EXPECT_NE(full.err.find("disk full"), std::string::npos) << full.err;
+  EXPECT_EQ(CliScratch::slurp(dir / "out/steps.csv"), steps);
+  for (const auto& f : dir.files()) {
+    EXPECT_EQ(f.find(".tmp"), std::string::npos) << f;
+  }
+}
+
 TEST(CliSimulate, ResumeFromDamagedOutput) {
   CliScratch dir;
   dir.write("s.json", kTinyScene);
