@@ -23,6 +23,7 @@
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/geometry/cone.hpp"
 #include "command.hpp"
+#include "misses.hpp"
 
 namespace clothcd::app {
 namespace {
@@ -221,21 +222,7 @@ void print_cone_comparison(std::uint64_t seed, int count) {
 
 namespace {
 
-std::size_t missed_against(const DetectResult& none, const DetectResult& r) {
-  std::vector<VertexFaceCollision> vf;
-  std::vector<EdgeEdgeCollision> ee;
-  auto vf_key = [](const VertexFaceCollision& x, const VertexFaceCollision& y) {
-    return std::pair(x.vertex, x.face) < std::pair(y.vertex, y.face);
-  };
-  auto ee_key = [](const EdgeEdgeCollision& x, const EdgeEdgeCollision& y) {
-    return std::pair(x.edge_a, x.edge_b) < std::pair(y.edge_a, y.edge_b);
-  };
-  std::set_difference(none.vf.begin(), none.vf.end(), r.vf.begin(), r.vf.end(),
-                      std::back_inserter(vf), vf_key);
-  std::set_difference(none.ee.begin(), none.ee.end(), r.ee.begin(), r.ee.end(),
-                      std::back_inserter(ee), ee_key);
-  return vf.size() + ee.size();
-}
+using cli::missed_against;
 
 struct DemoArgs {
   std::string scene = "crumpled";
