@@ -261,7 +261,9 @@ Scene load_scene(const std::filesystem::path& file) {
   json j;
   try {
     j = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // Not only parse_error: a number beyond double's range is an out_of_range (found by
+    // fuzz_scene).
     throw input_error(file.string(), 0, fmt::format("invalid JSON: {}", e.what()));
   }
   return parse_scene(j, file);

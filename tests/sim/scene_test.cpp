@@ -1,7 +1,9 @@
 // Scene JSON validation, procedural scenes, the substep rule and OBJ reading.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
+#include <string>
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/sim/obj_reader.hpp"
@@ -97,6 +99,25 @@ TEST(Scene, ValidationErrorsNameFileAndKey) {
     EXPECT_NE(msg.find("test-scene.json"), std::string::npos) << c.name << ": " << msg;
     EXPECT_NE(msg.find(c.expect), std::string::npos) << c.name << ": " << msg;
   }
+}
+
+// Found by fuzz_scene: a number beyond double's range made nlohmann throw out_of_range (not a
+// parse_error), which escaped load_scene as a bare json exception.
+TEST(Scene, HugeNumberIsAnInputError) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / "clothcd_scene_huge_number.json";
+  {
+    std::ofstream out(file);
+    out << "{\"name\": \"x\", \"frames\": 3333E0010613521}";
+  }
+  try {
+    (void)load_scene(file);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("invalid JSON"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(file);
 }
 
 TEST(Scene, SubstepRule) {
