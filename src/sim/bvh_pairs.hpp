@@ -9,13 +9,13 @@
 
 namespace clothcd::sim::detail {
 
-/// Calls fn(face_a, face_b) for every pair of leaves of `a` and `b` whose boxes overlap.
+/// Calls fn(face_a, face_b) for every pair of a leaf below node `i` of `a` and a leaf below node
+/// `j` of `b` whose boxes overlap.
 template <class Fn>
-void for_each_overlap(const Bvh& a, const Bvh& b, Fn&& fn) {
+void for_each_overlap_below(const Bvh& a, int i0, const Bvh& b, int j0, Fn&& fn) {
   const auto& na = a.nodes();
   const auto& nb = b.nodes();
-  if (na.empty() || nb.empty()) return;
-  std::vector<std::pair<int, int>> stack{{0, 0}};
+  std::vector<std::pair<int, int>> stack{{i0, j0}};
   while (!stack.empty()) {
     const auto [i, j] = stack.back();
     stack.pop_back();
@@ -34,35 +34,27 @@ void for_each_overlap(const Bvh& a, const Bvh& b, Fn&& fn) {
   }
 }
 
-/// Calls fn(f, g) once for every unordered pair of distinct leaves of `a` whose boxes overlap.
+/// Calls fn(face_a, face_b) for every pair of leaves of `a` and `b` whose boxes overlap.
+template <class Fn>
+void for_each_overlap(const Bvh& a, const Bvh& b, Fn&& fn) {
+  if (a.nodes().empty() || b.nodes().empty()) return;
+  for_each_overlap_below(a, 0, b, 0, fn);
+}
+
+/// Calls fn(f, g) once for every unordered pair of distinct leaves of `a` whose boxes overlap:
+/// for every internal node, the pairs across its two children.
 template <class Fn>
 void for_each_self_overlap(const Bvh& a, Fn&& fn) {
   const auto& n = a.nodes();
   if (n.empty()) return;
-  // (i, i) entries mean "pairs inside node i"; (i, j) with i != j mean "pairs across i and j".
-  std::vector<std::pair<int, int>> stack{{0, 0}};
+  std::vector<int> stack{0};
   while (!stack.empty()) {
-    const auto [i, j] = stack.back();
+    const BvhNode& x = n[stack.back()];
     stack.pop_back();
-    const BvhNode& x = n[i];
-    if (i == j) {
-      if (x.is_leaf()) continue;
-      stack.emplace_back(x.left, x.left);
-      stack.emplace_back(x.left + 1, x.left + 1);
-      stack.emplace_back(x.left, x.left + 1);
-      continue;
-    }
-    const BvhNode& y = n[j];
-    if (!overlap(x, y)) continue;
-    if (x.is_leaf() && y.is_leaf()) {
-      fn(a.prim_ids()[x.first], a.prim_ids()[y.first]);
-    } else if (y.is_leaf() || (!x.is_leaf() && x.count >= y.count)) {
-      stack.emplace_back(x.left, j);
-      stack.emplace_back(x.left + 1, j);
-    } else {
-      stack.emplace_back(i, y.left);
-      stack.emplace_back(i, y.left + 1);
-    }
+    if (x.is_leaf()) continue;
+    stack.push_back(x.left);
+    stack.push_back(x.left + 1);
+    for_each_overlap_below(a, x.left, a, x.left + 1, fn);
   }
 }
 
