@@ -53,6 +53,7 @@ struct SelfDetector::Impl {
   std::vector<std::uint8_t> face_active, vertex_active, edge_active, node_active;
   // Per-step swept boxes of the features (storage reused across steps).
   std::vector<detail::Box> vboxes, eboxes, fboxes;
+  std::vector<std::pair<int, int>> links;  // opt.linked_vertices, normalized per call
   detail::Ownership owner;
 
   Impl(std::vector<Face> faces, int nv, const Positions& ref, const DetectOptions& o)
@@ -136,6 +137,8 @@ struct SelfDetector::Impl {
     ctx.margin = 0.5 * opt.thickness;
     ctx.np_filter = opt.np_filter;
     ctx.ccd = CcdOptions{opt.thickness, opt.fast_path};
+    ctx.ccd.toi_tolerance = opt.toi_tolerance;
+    ctx.links = links;
     detail::precompute_boxes(ctx, vboxes, eboxes, fboxes);
     tbb::enumerable_thread_specific<NarrowBuffer> locals;
     auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
@@ -224,6 +227,7 @@ struct SelfDetector::Impl {
   DetectResult detect(const Positions& p0, const Positions& p1) {
     detail::to_points(p0, topo.num_vertices(), "positions at t0", v0);
     detail::to_points(p1, topo.num_vertices(), "positions at t1", v1);
+    links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
     DetectResult res;
     DetectStats& st = res.stats;
     auto t = Clock::now();

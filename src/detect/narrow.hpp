@@ -2,6 +2,7 @@
 // Feature-level tests shared by the detector and the brute-force oracle, so both put every VF and
 // EE pair through exactly the same box test, NP filter and kernel.
 
+#include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <Eigen/Core>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "clothcd/ccd/queries.hpp"
+#include "clothcd/core/error.hpp"
 #include "clothcd/detect/types.hpp"
 
 namespace clothcd::detail {
@@ -81,6 +83,14 @@ struct FeatureContext {
   /// Optional swept boxes of every vertex, edge and face for this step (`precompute_boxes`);
   /// empty: computed on demand.
   std::span<const Box> vboxes, eboxes, fboxes;
+  /// DetectOptions::linked_vertices as (smaller, larger), sorted and unique (`sorted_links`).
+  std::span<const std::pair<int, int>> links;
+
+  [[nodiscard]] bool grouped(int u, int v) const {
+    if (links.empty()) return false;
+    const std::pair<int, int> k = u < v ? std::pair(u, v) : std::pair(v, u);
+    return std::binary_search(links.begin(), links.end(), k);
+  }
 
   [[nodiscard]] Box compute_face_box(int f) const {
     const Face& t = topo->faces()[f];
@@ -103,11 +113,13 @@ struct FeatureContext {
 
   /// Vertex v against face f (their boxes already overlap): NP filter, then the kernel.
   void kernel_vf(int v, int f, FeatureCounters& c, std::vector<VertexFaceCollision>& out) const {
-    ++c.vf_tests;
     const Face& t = topo->faces()[f];
+    if (grouped(v, t[0]) || grouped(v, t[1]) || grouped(v, t[2])) return;
+    ++c.vf_tests;
     const VertexFaceQuery q{v0[v], v0[t[0]], v0[t[1]], v0[t[2]],
                             v1[v], v1[t[0]], v1[t[1]], v1[t[2]]};
-    if (separate_np() && np_filter_culls(q)) {
+    if ((separate_np() && np_filter_culls(q)) ||
+        (distance_filter() && distance_filter_culls(q, ccd.thickness))) {
       ++c.vf_np;
       return;
     }
@@ -118,12 +130,16 @@ struct FeatureContext {
 
   /// Edges ea < eb (their boxes already overlap).
   void kernel_ee(int ea, int eb, FeatureCounters& c, std::vector<EdgeEdgeCollision>& out) const {
-    ++c.ee_tests;
     const Edge& a = topo->edges()[ea];
     const Edge& b = topo->edges()[eb];
+    if (grouped(a[0], b[0]) || grouped(a[0], b[1]) || grouped(a[1], b[0]) || grouped(a[1], b[1])) {
+      return;
+    }
+    ++c.ee_tests;
     const EdgeEdgeQuery q{v0[a[0]], v0[a[1]], v0[b[0]], v0[b[1]],
                           v1[a[0]], v1[a[1]], v1[b[0]], v1[b[1]]};
-    if (separate_np() && np_filter_culls(q)) {
+    if ((separate_np() && np_filter_culls(q)) ||
+        (distance_filter() && distance_filter_culls(q, ccd.thickness))) {
       ++c.ee_np;
       return;
     }
@@ -138,10 +154,31 @@ struct FeatureContext {
   [[nodiscard]] bool separate_np() const {
     return np_filter && ccd.thickness == 0 && !ccd.fast_path;
   }
+  // With a thickness the cubic filter does not apply; the distance bound takes its place (it
+  // culls resting contact, the bulk of a simulator's pairs).
+  [[nodiscard]] bool distance_filter() const { return np_filter && ccd.thickness > 0; }
   [[nodiscard]] bool counted_np(const CcdResult& r) const {
     return np_filter && r.path == CcdPath::np_culled;
   }
 };
+
+/// DetectOptions::linked_vertices normalized for FeatureContext::links; throws InputError for an
+/// id outside [0, num_vertices).
+inline std::vector<std::pair<int, int>> sorted_links(const std::vector<std::pair<int, int>>& in,
+                                                     int num_vertices) {
+  std::vector<std::pair<int, int>> out;
+  out.reserve(in.size());
+  for (auto [a, b] : in) {
+    if (a < 0 || b < 0 || a >= num_vertices || b >= num_vertices) {
+      throw InputError(
+          fmt::format("linked_vertices: pair ({}, {}) is outside 0..{}", a, b, num_vertices - 1));
+    }
+    if (a != b) out.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
 
 /// Fills the context's box arrays for this step (in parallel), reusing the given storage: each
 /// box is then computed once per step instead of once per triangle pair that needs it.

@@ -29,6 +29,7 @@ detail::FeatureContext make_context(const Topology& topo, const std::vector<Eige
   ctx.margin = 0.5 * o.thickness;
   ctx.np_filter = o.np_filter;
   ctx.ccd = CcdOptions{o.thickness, o.fast_path};
+  ctx.ccd.toi_tolerance = o.toi_tolerance;
   return ctx;
 }
 
@@ -40,7 +41,9 @@ DetectResult brute_force_detect(const Topology& topo, const Positions& p0, const
   std::vector<Eigen::Vector3d> v0, v1;
   detail::to_points(p0, topo.num_vertices(), "positions at t0", v0);
   detail::to_points(p1, topo.num_vertices(), "positions at t1", v1);
-  const detail::FeatureContext ctx = make_context(topo, v0, v1, options);
+  const auto links = detail::sorted_links(options.linked_vertices, topo.num_vertices());
+  detail::FeatureContext ctx = make_context(topo, v0, v1, options);
+  ctx.links = links;
   const bool restricted = !active.empty();
   std::vector<std::uint8_t> vact(topo.num_vertices(), 0), eact(topo.num_edges(), 0);
   for (int f = 0; f < topo.num_faces() && restricted; ++f) {

@@ -181,6 +181,7 @@ nlohmann::json to_json(const FrameStats& s) {
           {"largest_zone", s.largest_zone},
           {"zone_rounds", s.zone_rounds},
           {"unresolved_ccd_hits", s.unresolved},
+          {"excluded_ccd_hits", s.excluded},
           // null when not counted (a non-finite state or counting switched off)
           {"self_intersections",
            s.self_intersections >= 0 ? nlohmann::json(s.self_intersections) : nlohmann::json()},

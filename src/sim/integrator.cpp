@@ -149,6 +149,7 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
     stats.collision.zones += cs.zones;
     stats.collision.zone_rounds += cs.zone_rounds;
     stats.collision.unresolved += cs.unresolved;
+    stats.collision.excluded += cs.excluded;
     stats.collision.largest_zone = std::max(stats.collision.largest_zone, cs.largest_zone);
     stats.collision.seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

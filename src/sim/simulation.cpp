@@ -71,6 +71,7 @@ FrameStats Simulation::advance_frame() {
     fs.largest_zone = std::max(fs.largest_zone, st.collision.largest_zone);
     fs.zone_rounds += st.collision.zone_rounds;
     fs.unresolved += st.collision.unresolved;
+    fs.excluded += st.collision.excluded;
   }
   state_.time = t1;
   ++frame_;

@@ -74,4 +74,12 @@ struct CcdResult {
 [[nodiscard]] bool np_filter_culls(const VertexFaceQuery& q);
 [[nodiscard]] bool np_filter_culls(const EdgeEdgeQuery& q);
 
+/// Distance filter (any thickness): true when the features provably stay farther apart than
+/// `thickness` during the whole motion. The distance is Lipschitz in t with constant D, the largest
+/// relative displacement of a vertex of one feature against a vertex of the other, so it never
+/// drops below (d0 + d1 - D) / 2 (d0, d1: the distances at both ends; docs/ccd.md). Cheap for
+/// resting contact, where the cubic filter cannot help because thickness > 0.
+[[nodiscard]] bool distance_filter_culls(const VertexFaceQuery& q, double thickness);
+[[nodiscard]] bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness);
+
 }  // namespace clothcd

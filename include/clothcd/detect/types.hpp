@@ -3,6 +3,7 @@
 /// Options, collisions and statistics of the collision detection pipeline.
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "clothcd/bvh/bvh.hpp"
@@ -29,8 +30,15 @@ struct DetectOptions {
   bool np_filter = true;
   /// CcdOptions::fast_path of the kernels.
   bool fast_path = true;
+  /// CcdOptions::toi_tolerance of the kernels: how closely a hit's time of impact is refined
+  /// (always on the early side). A simulator's response rarely needs more than a few percent.
+  double toi_tolerance = 1e-4;
   /// Also run the unculled traversal and report what the culled one missed.
   bool verify = false;
+  /// Optional vertex pairs that count as one point (the two sides of a stitched seam): VF and EE
+  /// pairs joining them are not tested, like pairs that share a vertex. Any order; duplicates
+  /// allowed.
+  std::vector<std::pair<int, int>> linked_vertices;
 };
 
 /// Vertex `vertex` hits face `face` (vertex ids `face_vertices`) at time `toi` in [0, 1].

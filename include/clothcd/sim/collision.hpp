@@ -34,6 +34,7 @@ struct CollisionStats {
   int largest_zone = 0;
   int zone_rounds = 0;
   long long unresolved = 0;  ///< CCD hits still present when the zone rounds ran out
+  long long excluded = 0;    ///< CCD hits left out: their triangles already crossed at t0
   double seconds = 0.0;
 };
 

@@ -34,6 +34,7 @@ struct FrameStats {
   int largest_zone = 0;
   int zone_rounds = 0;
   long long unresolved = 0;  ///< CCD hits left when zone rounds ran out
+  long long excluded = 0;    ///< CCD hits left out because their triangles already crossed
   /// Intersecting triangle pairs at the frame's end (-1: not counted).
   long long self_intersections = -1;
   long long body_intersections = -1;
