@@ -13,6 +13,7 @@
 
 #include "api_scenes.hpp"
 #include "clothcd/ccd/proximity.hpp"
+#include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/oracle.hpp"
 #include "clothcd/detect/procedural.hpp"
@@ -164,6 +165,67 @@ TEST(DetectApi, DeterministicOnOneTwoAndFourThreads) {
       EXPECT_EQ(counters(pr.stats), counters(first_pair->stats));
     }
   }
+}
+
+// Linked vertices (stitched seams) count as one point: the detector, on both builds and with and
+// without culling, equals brute force with the same links, which equals brute force without links
+// minus exactly the pairs that join two linked vertices.
+TEST(DetectApi, LinkedVerticesDropExactlyThePairsJoiningThem) {
+  const ProceduralScene s = crumpled_sheet(12, 6);
+  const Topology topo(s.faces, s.num_vertices);
+  const DetectResult all = brute_force_detect(topo, s.v_t0, s.v_t1);
+  ASSERT_GE(all.vf.size(), 3u);
+  ASSERT_GE(all.ee.size(), 3u);
+  // Link the two ends of every third colliding VF pair (vertex with a face corner) and of every
+  // third EE pair (first ends), as a seam would.
+  DetectOptions o;
+  for (std::size_t i = 0; i < all.vf.size(); i += 3)
+    o.linked_vertices.emplace_back(all.vf[i].face_vertices[1], all.vf[i].vertex);
+  for (std::size_t i = 0; i < all.ee.size(); i += 3)
+    o.linked_vertices.emplace_back(all.ee[i].edge_a_vertices[0], all.ee[i].edge_b_vertices[0]);
+  auto linked = [&](int u, int v) {
+    for (auto [a, b] : o.linked_vertices) {
+      if ((a == u && b == v) || (a == v && b == u)) return true;
+    }
+    return false;
+  };
+  DetectResult expected;
+  for (const auto& c : all.vf) {
+    const Face& t = c.face_vertices;
+    if (!linked(c.vertex, t[0]) && !linked(c.vertex, t[1]) && !linked(c.vertex, t[2]))
+      expected.vf.push_back(c);
+  }
+  for (const auto& c : all.ee) {
+    bool any = false;
+    for (int a : c.edge_a_vertices) {
+      for (int b : c.edge_b_vertices)
+        any = any || linked(a, b);
+    }
+    if (!any) expected.ee.push_back(c);
+  }
+  ASSERT_LT(expected.vf.size(), all.vf.size());
+  ASSERT_LT(expected.ee.size(), all.ee.size());
+  const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1, o);
+  EXPECT_EQ(ref.vf, expected.vf);
+  EXPECT_EQ(ref.ee, expected.ee);
+  for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+    for (Culling culling : {Culling::None, Culling::Sound}) {
+      o.build = build;
+      o.culling = culling;
+      SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+      const DetectResult r = det.detect(s.v_t0, s.v_t1);
+      EXPECT_EQ(r.vf, expected.vf) << int(build) << " " << int(culling);
+      EXPECT_EQ(r.ee, expected.ee) << int(build) << " " << int(culling);
+    }
+  }
+}
+
+TEST(DetectApi, LinkedVertexOutOfRangeIsAnInputError) {
+  const ProceduralScene s = crumpled_sheet(3, 1);
+  DetectOptions o;
+  o.linked_vertices = {{0, s.num_vertices}};
+  SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+  EXPECT_THROW((void)det.detect(s.v_t0, s.v_t1), InputError);
 }
 
 }  // namespace

@@ -125,5 +125,48 @@ TEST(ContactHandler, BodyHasInfiniteMass) {
   EXPECT_TRUE(c.body_pairs(s.x1, body1).empty());
 }
 
+TEST(ContactHandler, RestingPairInsideTheSeparationIsNotAHit) {
+  // 5 um apart (inside the 10 um CCD separation), sliding together: the pair never approaches,
+  // so it is not a CCD hit (it used to be one at toi 0 in every pass and zone round).
+  const ClothModel m(two_triangles(5e-6), ClothMaterial{});
+  const std::vector<Vec3> v(6, Vec3(0.4, 0.0, -0.2));
+  const OneStep s = one_step(m, v, 0.01);
+  EXPECT_GT(s.stats.proximity_pairs, 0);
+  EXPECT_EQ(s.stats.ccd_hits, 0);
+  EXPECT_EQ(s.stats.zone_rounds, 0);
+  for (int i = 3; i < 6; ++i)
+    EXPECT_GT(s.x1[i].y(), s.x1[0].y());  // still above
+}
+
+TEST(ContactHandler, PairsAlreadyCrossingAreLeftOutNotFought) {
+  // A lower triangle (0-2), a triangle (3-5) already crossing it whose lower vertex rises through
+  // it, and a triangle (6-8) falling onto it. CCD cannot undo the crossing, so the pairs of the
+  // crossing faces are left out (counted) instead of filling every zone round; the falling
+  // triangle is still stopped.
+  ClothMeshInput in;
+  in.positions = {{0, 0, 0},         {1, 0, 0},        {0, 0, 1},          // lower
+                  {0.1, -0.05, 0.5}, {0.3, 0.05, 0.5}, {0.1, 0.05, 0.8},   // crossing
+                  {0.5, 0.01, 0.1},  {0.8, 0.01, 0.1}, {0.5, 0.01, 0.4}};  // falling
+  in.faces = {{0, 2, 1}, {3, 5, 4}, {6, 8, 7}};
+  const ClothModel m(in, ClothMaterial{});
+  IntersectionCounter count(m.topology(), {}, {}, 0);
+  ASSERT_EQ(count.self_pairs(m.initial_positions()).size(), 1u);
+  std::vector<Vec3> v(9, Vec3::Zero());
+  v[3] = Vec3(0.0, 8.0, 0.0);  // 8 cm up in the substep: through the lower triangle
+  for (int i = 6; i < 9; ++i)
+    v[i] = Vec3(0.0, -2.0, 0.0);  // 2 cm down through a 1 cm gap
+  const OneStep s = one_step(m, v, 0.01);
+  EXPECT_GT(s.stats.excluded, 0);
+  EXPECT_EQ(s.stats.unresolved, 0);
+  EXPECT_LT(s.stats.zone_rounds, ContactOptions{}.zone_rounds);
+  EXPECT_GT(s.x1[3].y(), 0.02);  // the excluded vertex was not held back
+  const Vec3 n = (s.x1[2] - s.x1[0]).cross(s.x1[1] - s.x1[0]).normalized();
+  ASSERT_GT(n.y(), 0.9);
+  for (int i = 6; i < 9; ++i)
+    EXPECT_GT(n.dot(s.x1[i] - s.x1[0]), 0.0);  // the falling triangle stays above
+  // The crossing is gone or unchanged, and no new one appeared.
+  EXPECT_LE(count.self_pairs(s.x1).size(), 1u);
+}
+
 }  // namespace
 }  // namespace clothcd::sim

@@ -78,7 +78,8 @@ struct CcdResult {
 /// `thickness` during the whole motion. The distance is Lipschitz in t with constant D, the largest
 /// relative displacement of a vertex of one feature against a vertex of the other, so it never
 /// drops below (d0 + d1 - D) / 2 (d0, d1: the distances at both ends; docs/ccd.md). Cheap for
-/// resting contact, where the cubic filter cannot help because thickness > 0.
+/// resting contact, where the cubic filter cannot help because thickness > 0. NaN or infinite
+/// coordinates throw std::invalid_argument.
 [[nodiscard]] bool distance_filter_culls(const VertexFaceQuery& q, double thickness);
 [[nodiscard]] bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness);
 

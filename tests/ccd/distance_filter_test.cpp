@@ -1,0 +1,106 @@
+// The distance filter never culls a pair that comes within the thickness: every cull is checked
+// by sampling the distance along the motion (exact distances at 2001 instants), on random resting
+// and moving pairs at several scales.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "clothcd/ccd/proximity.hpp"
+#include "clothcd/ccd/queries.hpp"
+
+namespace clothcd {
+namespace {
+
+using V = Eigen::Vector3d;
+constexpr int kSamples = 2000;
+
+double min_distance(const VertexFaceQuery& q) {
+  double d = INFINITY;
+  for (int i = 0; i <= kSamples; ++i) {
+    const double t = double(i) / kSamples;
+    auto at = [t](const V& a, const V& b) -> V { return a + t * (b - a); };
+    d = std::min(d, point_triangle_proximity(at(q.v_t0, q.v_t1), at(q.f0_t0, q.f0_t1),
+                                             at(q.f1_t0, q.f1_t1), at(q.f2_t0, q.f2_t1))
+                        .distance);
+  }
+  return d;
+}
+
+double min_distance(const EdgeEdgeQuery& q) {
+  double d = INFINITY;
+  for (int i = 0; i <= kSamples; ++i) {
+    const double t = double(i) / kSamples;
+    auto at = [t](const V& a, const V& b) -> V { return a + t * (b - a); };
+    d = std::min(d, edge_edge_proximity(at(q.ea0_t0, q.ea0_t1), at(q.ea1_t0, q.ea1_t1),
+                                        at(q.eb0_t0, q.eb0_t1), at(q.eb1_t0, q.eb1_t1))
+                        .distance);
+  }
+  return d;
+}
+
+// Features near each other (resting-contact-like gaps) with moves up to `move` per vertex.
+struct Generator {
+  std::mt19937_64 rng;
+  double scale, move;
+  V point() { return scale * V(u(rng), u(rng), u(rng)); }
+  V step(const V& p) { return p + move * V(u(rng), u(rng), u(rng)); }
+  std::uniform_real_distribution<> u{-1.0, 1.0};
+};
+
+TEST(DistanceFilter, NeverCullsAPairThatComesWithinTheThickness) {
+  int culled_vf = 0, culled_ee = 0, cases = 0;
+  for (double scale : {1e-3, 1e-2, 1.0}) {
+    for (double move_ratio : {0.01, 0.1, 1.0}) {
+      Generator g{std::mt19937_64(17), scale, move_ratio * scale};
+      for (int i = 0; i < 300; ++i, ++cases) {
+        const double thickness = scale * std::pow(10.0, -1 - 3 * (i % 4) / 3.0);
+        const V a = g.point(), b = g.point(), c = g.point(), d = g.point();
+        const VertexFaceQuery vf{a, b, c, d, g.step(a), g.step(b), g.step(c), g.step(d)};
+        if (distance_filter_culls(vf, thickness)) {
+          ++culled_vf;
+          ASSERT_GT(min_distance(vf), thickness) << "scale " << scale << " case " << i;
+        }
+        const EdgeEdgeQuery ee{a, b, c, d, g.step(a), g.step(b), g.step(c), g.step(d)};
+        if (distance_filter_culls(ee, thickness)) {
+          ++culled_ee;
+          ASSERT_GT(min_distance(ee), thickness) << "scale " << scale << " case " << i;
+        }
+      }
+    }
+  }
+  // The filter must also do its job: small relative moves are culled often.
+  EXPECT_GT(culled_vf, cases / 4);
+  EXPECT_GT(culled_ee, cases / 4);
+}
+
+TEST(DistanceFilter, RestingPairMovingTogetherIsCulled) {
+  // A vertex 1 mm above a face; both translate by 5 cm: the gap never changes.
+  const V shift(0.05, -0.02, 0.03);
+  const V p(0.2, 0.2, 0.001), a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  const VertexFaceQuery q{p, a, b, c, p + shift, a + shift, b + shift, c + shift};
+  EXPECT_TRUE(distance_filter_culls(q, 1e-5));
+  EXPECT_FALSE(distance_filter_culls(q, 0.0011));  // thicker than the gap
+}
+
+TEST(DistanceFilter, CrossingPairIsNotCulled) {
+  const V a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  const VertexFaceQuery vf{V(0.2, 0.2, 0.1), a, b, c, V(0.2, 0.2, -0.1), a, b, c};
+  EXPECT_FALSE(distance_filter_culls(vf, 0.0));
+  const EdgeEdgeQuery ee{V(0.5, -1, 0.1),  V(0.5, 1, 0.1),  V(0, 0, 0), V(1, 0, 0),
+                         V(0.5, -1, -0.1), V(0.5, 1, -0.1), V(0, 0, 0), V(1, 0, 0)};
+  EXPECT_FALSE(distance_filter_culls(ee, 0.0));
+}
+
+TEST(DistanceFilter, NonFiniteThrowsLikeTheKernels) {
+  const V a(0, 0, 0), b(1, 0, 0), c(0, 1, 0), n(NAN, 0, 0);
+  EXPECT_THROW((void)distance_filter_culls(VertexFaceQuery{n, a, b, c, n, a, b, c}, 0.0),
+               std::invalid_argument);
+  EXPECT_THROW((void)distance_filter_culls(EdgeEdgeQuery{n, a, b, c, n, a, b, c}, 0.0),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace clothcd
