@@ -740,6 +740,9 @@ struct ContactHandler::Impl {
     UnionFind uf(n);
     std::vector<std::uint8_t> in_zone(n, 0);
     std::vector<std::pair<int, Vec3>> anchors;  // cloth vertex, velocity it must follow
+    // Per substep: 0.1 mm with the scenes' settings (dress-rumba frames 1-12: no body crossing
+    // and max stretch 0.96, against 25 crossing pairs and 1.2-3.2 without it).
+    const double anchor_push = std::max(2.0 * opt.ccd_thickness, 0.1 * opt.thickness);
     std::vector<Vec3> vertex_anchor_sum(n, Vec3::Zero());
     std::vector<int> vertex_anchor_count(n, 0);
     std::vector<int> active = faces_of(changed);
@@ -779,7 +782,13 @@ struct ContactHandler::Impl {
         }
         if (body_w > 0) {
           for (int k = 0; k < 4; ++k) {
-            if (!c.on_body[k]) anchors.emplace_back(c.id[k], body_v / body_w);
+            // Follow the body point, plus a small push out along the contact normal (the cloth
+            // side is where its weights point): matching the body's velocity alone keeps a
+            // near-zero gap that the body's own deformation then closes.
+            if (!c.on_body[k]) {
+              const double side = c.c[k] > 0 ? 1.0 : -1.0;
+              anchors.emplace_back(c.id[k], body_v / body_w + side * anchor_push / h * c.n);
+            }
           }
         }
       }
