@@ -1,6 +1,7 @@
 // `clothcd experiment --scene S ... --out DIR`: every cone policy x culling rule x BVH build over
-// the same recorded frames; writes steps.csv, table1.md, table2.md, misses.md, spread.md and the
-// figures fig5.png / fig6.png (scripts/plot_experiment.py with Debian's python3-matplotlib).
+// the same recorded frames; writes steps.csv, table1.md, table2.md, misses.md, spread.md,
+// summary.md and the figures fig5.png / fig6.png (scripts/plot_experiment.py with Debian's
+// python3-matplotlib).
 #include <fmt/format.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
@@ -242,8 +243,10 @@ int run(const Args& a) {
       rc = 1;
     }
   }
-  fmt::print("results in {}: steps.csv, spread.csv, table1.md, table2.md, misses.md, spread.md{}\n",
-             a.out, a.no_plots || rc != 0 ? "" : ", fig5.png, fig6.png");
+  fmt::print(
+      "results in {}: steps.csv, spread.csv, table1.md, table2.md, misses.md, spread.md, "
+      "summary.md{}\n",
+      a.out, a.no_plots || rc != 0 ? "" : ", fig5.png, fig6.png");
   return rc;
 }
 

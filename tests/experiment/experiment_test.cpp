@@ -158,6 +158,10 @@ TEST(Experiment, RowsPerStepAndConfigurationSoundEqualsReference) {
   EXPECT_GE(check_markdown_tables(t2), 20);
   EXPECT_GE(check_markdown_tables(mi), 18);
   EXPECT_GE(check_markdown_tables(slurp(opt.out / "spread.md")), 8);
+  // Summary: one row per build and culling rule, with PROVOT's misses equal to misses.md's.
+  const std::string su = slurp(opt.out / "summary.md");
+  EXPECT_EQ(check_markdown_tables(su), 7);  // separator + 2 builds x 3 rules
+  EXPECT_NE(su.find("| spatial | sound | "), std::string::npos);
   EXPECT_NE(t1.find("| spatial | gated | EXACT | 4 |"), std::string::npos);
   EXPECT_NE(t2.find("| patch | sound | PROVOT | 4 |"), std::string::npos);
   EXPECT_NE(mi.find("Summary: 0 sound configuration(s) with misses, 0 with extra pairs."),
