@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 #include "clothcd/core/error.hpp"
 
@@ -130,6 +131,47 @@ ClothModel::ClothModel(const ClothMeshInput& in, const ClothMaterial& material)
     StitchTerm t = make_stitch(st);
     if (t.count >= 2) stitches_.push_back(t);
   }
+  link_seams();
+}
+
+void ClothModel::link_seams() {
+  const int n = topology_.num_vertices();
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int a) {
+    while (parent[a] != a)
+      a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (const StitchTerm& t : stitches_) {
+    for (int i = 0; i < t.count; ++i) {
+      for (int j = i + 1; j < t.count; ++j) {
+        seam_links_.emplace_back(std::min(t.v[i], t.v[j]), std::max(t.v[i], t.v[j]));
+      }
+      parent[find(t.v[i])] = find(t.v[0]);
+    }
+  }
+  double length = 0.0;
+  for (const Edge& e : topology_.edges())
+    length += (initial_[e[0]] - initial_[e[1]]).norm();
+  const double radius = topology_.num_edges() > 0 ? length / topology_.num_edges() : 0.0;
+  std::vector<std::vector<int>> groups(n);
+  for (const StitchTerm& t : stitches_) {
+    for (int i = 0; i < t.count; ++i)
+      groups[find(t.v[i])].push_back(t.v[i]);
+  }
+  for (auto& g : groups) {
+    std::sort(g.begin(), g.end());
+    g.erase(std::unique(g.begin(), g.end()), g.end());
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      for (std::size_t j = i + 1; j < g.size(); ++j) {
+        if ((initial_[g[i]] - initial_[g[j]]).norm() <= radius)
+          seam_links_.emplace_back(g[i], g[j]);
+      }
+    }
+  }
+  std::sort(seam_links_.begin(), seam_links_.end());
+  seam_links_.erase(std::unique(seam_links_.begin(), seam_links_.end()), seam_links_.end());
 }
 
 }  // namespace clothcd::sim

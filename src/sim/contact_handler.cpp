@@ -119,7 +119,7 @@ struct ContactHandler::Impl {
   Positions x0m;
 
   Impl(const ClothModel& m, const ContactOptions& o)
-      : model(m), opt(o), links(m.num_vertices(), m.stitches()) {}
+      : model(m), opt(o), links(m.num_vertices(), m.seam_links()) {}
 
   [[nodiscard]] const Vec3& position(const Contact& c, int k, double tau, std::span<const Vec3> v,
                                      Vec3& tmp) const {
@@ -288,7 +288,7 @@ struct ContactHandler::Impl {
     static const std::vector<Face> kNoFaces;
     if (!crossing) {
       const bool body = has_body(ctx);
-      crossing.emplace(model.topology(), model.stitches(), body ? *ctx.body_faces : kNoFaces,
+      crossing.emplace(model.topology(), model.seam_links(), body ? *ctx.body_faces : kNoFaces,
                        body ? static_cast<int>(ctx.body_t0.size()) : 0);
     }
     crossing_self.clear();
@@ -329,13 +329,8 @@ struct ContactHandler::Impl {
         o.culling = Culling::Sound;  // never the unsound cone rules in the simulator
         o.thickness = opt.ccd_thickness;
         o.toi_tolerance = kToiTolerance;
-        // Stitched vertices count as one point: the seam's sides touch by design.
-        for (const StitchTerm& st : model.stitches()) {
-          for (int i = 0; i < st.count; ++i) {
-            for (int j = i + 1; j < st.count; ++j)
-              o.linked_vertices.emplace_back(st.v[i], st.v[j]);
-          }
-        }
+        // Seam-linked vertices count as one point: the seam's sides touch by design.
+        o.linked_vertices = model.seam_links();
         self.emplace(model.topology().faces(), model.num_vertices(), x0m, o);
       }
       const ProximityResult r = self->proximity(x0m, dh);

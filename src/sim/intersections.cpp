@@ -44,7 +44,8 @@ struct IntersectionCounter::Impl {
   Bvh cloth_bvh, body_bvh;
   bool cloth_built = false, body_built = false;
 
-  Impl(const Topology& c, std::span<const StitchTerm> st, const std::vector<Face>& bf, int nb)
+  Impl(const Topology& c, std::span<const std::pair<int, int>> st, const std::vector<Face>& bf,
+       int nb)
       : cloth(c), links(c.num_vertices(), st) {
     if (!bf.empty()) body.emplace(bf, nb);
   }
@@ -61,9 +62,9 @@ struct IntersectionCounter::Impl {
 };
 
 IntersectionCounter::IntersectionCounter(const Topology& cloth,
-                                         std::span<const StitchTerm> stitches,
+                                         std::span<const std::pair<int, int>> links,
                                          const std::vector<Face>& body_faces, int body_vertices)
-    : impl_(std::make_unique<Impl>(cloth, stitches, body_faces, body_vertices)) {}
+    : impl_(std::make_unique<Impl>(cloth, links, body_faces, body_vertices)) {}
 IntersectionCounter::~IntersectionCounter() = default;
 
 std::vector<std::pair<int, int>> IntersectionCounter::self_pairs(std::span<const Vec3> x) {

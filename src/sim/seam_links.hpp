@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "clothcd/sim/cloth_model.hpp"
@@ -13,20 +14,18 @@ namespace clothcd::sim::detail {
 class SeamLinks {
  public:
   SeamLinks() = default;
-  SeamLinks(int num_vertices, std::span<const StitchTerm> stitches) : links_(num_vertices) {
-    for (const StitchTerm& s : stitches) {
-      for (int i = 0; i < s.count; ++i) {
-        for (int j = 0; j < s.count; ++j) {
-          if (i != j) links_[s.v[i]].push_back(s.v[j]);
-        }
-      }
+  /// `pairs`: ClothModel::seam_links() (any order).
+  SeamLinks(int num_vertices, std::span<const std::pair<int, int>> pairs) : links_(num_vertices) {
+    for (auto [u, w] : pairs) {
+      links_[u].push_back(w);
+      links_[w].push_back(u);
     }
     for (auto& l : links_) {
       std::sort(l.begin(), l.end());
       l.erase(std::unique(l.begin(), l.end()), l.end());
     }
   }
-  /// True when u == v or a stitch ties them.
+  /// True when u == v or the seam links tie them.
   [[nodiscard]] bool linked(int u, int v) const {
     if (u == v) return true;
     if (links_.empty()) return false;

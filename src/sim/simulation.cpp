@@ -17,7 +17,7 @@ Simulation::Simulation(Scene scene) : scene_(std::move(scene)) {
     solver_->set_collision_handler(contact_.get());
   }
   static const std::vector<Face> kNoFaces;
-  counter_ = std::make_unique<IntersectionCounter>(model_->topology(), model_->stitches(),
+  counter_ = std::make_unique<IntersectionCounter>(model_->topology(), model_->seam_links(),
                                                    scene_.body ? scene_.body->faces() : kNoFaces,
                                                    scene_.body ? scene_.body->num_vertices() : 0);
   state_ = solver_->initial_state();

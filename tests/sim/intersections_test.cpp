@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <random>
 
 #include "grid.hpp"
@@ -68,15 +70,50 @@ TEST(IntersectionCounter, FlatGridHasNoneAndStitchedPairsAreSkipped) {
   const auto crossings = plain.self_pairs(x);
   EXPECT_FALSE(crossings.empty());
   EXPECT_EQ(crossings, plain.self_pairs_brute_force(x));
-  // A stitch between every vertex and its neighbours hides them all.
-  std::vector<StitchTerm> ties;
+  // A link between every two vertices hides them all.
+  std::vector<std::pair<int, int>> ties;
   for (int v = 0; v < n; ++v) {
-    for (int u = 0; u < n; ++u) {
-      if (u != v) ties.push_back({{v, u, u}, {1.0, -1.0, 0.0}, 2});
-    }
+    for (int u = v + 1; u < n; ++u)
+      ties.emplace_back(v, u);
   }
   IntersectionCounter tied(cloth, ties, {}, 0);
   EXPECT_TRUE(tied.self_pairs(x).empty());
+}
+
+// Two strips 1 mm apart sewn along their long edges by vertex-to-edge stitches (one chain from
+// end to end): the seam links hold each stitch's vertices and the chain's vertices within one
+// mean edge length, never the two ends of the seam.
+TEST(SeamLinks, JoinNearbyVerticesOfAStitchChainOnly) {
+  ClothMeshInput in = test::grid_cloth(10, 1, 0.1, 0.01);  // vertices 0-10 at z=0, 11-21 at z=1cm
+  const ClothMeshInput other = test::grid_cloth(10, 1, 0.1, 0.01);
+  const int n0 = static_cast<int>(in.positions.size());
+  for (const Vec3& p : other.positions)
+    in.positions.push_back(p + Vec3(0.0, 0.0, 0.011));  // 1 mm beyond the first strip's far edge
+  for (const Face& f : other.faces)
+    in.faces.push_back({f[0] + n0, f[1] + n0, f[2] + n0});
+  // Vertex i of the first strip's far edge (11 + i) to the middle of edge (i, i+1) of the second
+  // strip's near edge (n0 + i, n0 + i + 1).
+  for (int i = 0; i < 10; ++i)
+    in.stitches.push_back({11 + i, n0 + i, n0 + i + 1, 0.5});
+  const ClothModel m(in, ClothMaterial{});
+  const auto& links = m.seam_links();
+  auto linked = [&](int a, int b) {
+    return std::binary_search(links.begin(), links.end(),
+                              std::pair(std::min(a, b), std::max(a, b)));
+  };
+  EXPECT_TRUE(std::is_sorted(links.begin(), links.end()));
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_TRUE(linked(11 + i, n0 + i)) << i;      // a stitch term
+    EXPECT_TRUE(linked(11 + i, n0 + i + 1)) << i;  // a stitch term
+  }
+  EXPECT_TRUE(linked(12, n0));        // same chain, 1.005 cm apart: within one mean edge (1.14 cm)
+  EXPECT_FALSE(linked(11, n0 + 2));   // same chain, 2 cm apart
+  EXPECT_FALSE(linked(11, n0 + 10));  // same chain, 10 cm apart
+  EXPECT_FALSE(linked(0, n0));        // not on the seam
+  // Counting: faces across the seam touch by construction and are not reported; a crossing far
+  // from the seam still is.
+  IntersectionCounter counter(m.topology(), links, {}, 0);
+  EXPECT_TRUE(counter.self_pairs(m.initial_positions()).empty());
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 /// ClothState.
 
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "clothcd/mesh/topology.hpp"
@@ -71,9 +72,19 @@ class ClothModel {
   [[nodiscard]] int num_slivers() const { return num_slivers_; }
   [[nodiscard]] const std::vector<Hinge>& hinges() const { return hinges_; }
   [[nodiscard]] const std::vector<StitchTerm>& stitches() const { return stitches_; }
+  /// Vertex pairs (u < w, sorted) that collisions and intersection counts treat as one point:
+  /// the vertices of each stitch term, and vertices joined by a chain of stitches that lie
+  /// within one mean edge length of each other in the initial shape. A seam sews panels by
+  /// vertex-to-edge stitches whose allowances overlap, so faces a few millimetres apart across
+  /// a seam touch or cross by construction (the multilayer drape's 22 "crossings" at frame 0 are
+  /// all such pairs); a welded mesh would make them neighbours. The distance bound keeps the
+  /// two ends of a long seam (one chain) apart.
+  [[nodiscard]] const std::vector<std::pair<int, int>>& seam_links() const { return seam_links_; }
   [[nodiscard]] const std::vector<Vec3>& initial_positions() const { return initial_; }
 
  private:
+  void link_seams();
+
   Topology topology_;
   ClothMaterial material_;
   MembraneModuli moduli_;
@@ -83,6 +94,7 @@ class ClothModel {
   int num_slivers_ = 0;
   std::vector<Hinge> hinges_;
   std::vector<StitchTerm> stitches_;
+  std::vector<std::pair<int, int>> seam_links_;
   std::vector<Vec3> initial_;
 };
 

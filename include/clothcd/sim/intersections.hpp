@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// Intersecting triangle pairs of a frame (docs/simulator.md 3.5): the cloth with itself (pairs
-/// sharing a vertex or tied by a stitch are skipped) and the cloth with the body. A BVH prefilter
-/// (clothcd::Bvh, static boxes) feeds a discrete triangle-triangle test.
+/// sharing a vertex or tied by a seam link are skipped) and the cloth with the body. A BVH
+/// prefilter (clothcd::Bvh, static boxes) feeds a discrete triangle-triangle test.
 
 #include <memory>
 #include <span>
@@ -22,8 +22,9 @@ namespace clothcd::sim {
 
 class IntersectionCounter {
  public:
-  /// `body_faces` may be empty (no body); `stitches` are the cloth model's ties.
-  IntersectionCounter(const Topology& cloth, std::span<const StitchTerm> stitches,
+  /// `body_faces` may be empty (no body); `links` are the cloth model's seam links (vertex pairs
+  /// that count as one point, ClothModel::seam_links()).
+  IntersectionCounter(const Topology& cloth, std::span<const std::pair<int, int>> links,
                       const std::vector<Face>& body_faces, int body_vertices);
   ~IntersectionCounter();
 
