@@ -17,28 +17,33 @@ namespace {
 using V = Eigen::Vector3d;
 constexpr int kSamples = 2000;
 
-double min_distance(const VertexFaceQuery& q) {
+// Smallest of the exact distances at 2001 instants of the linear motion.
+template <class Distance>
+double sampled_min(Distance&& at) {
   double d = INFINITY;
-  for (int i = 0; i <= kSamples; ++i) {
-    const double t = double(i) / kSamples;
-    auto at = [t](const V& a, const V& b) -> V { return a + t * (b - a); };
-    d = std::min(d, point_triangle_proximity(at(q.v_t0, q.v_t1), at(q.f0_t0, q.f0_t1),
-                                             at(q.f1_t0, q.f1_t1), at(q.f2_t0, q.f2_t1))
-                        .distance);
-  }
+  for (int i = 0; i <= kSamples; ++i)
+    d = std::min(d, at(double(i) / kSamples));
   return d;
 }
 
+V lerp(const V& a, const V& b, double t) {
+  return a + t * (b - a);
+}
+
+double min_distance(const VertexFaceQuery& q) {
+  return sampled_min([&](double t) {
+    return point_triangle_proximity(lerp(q.v_t0, q.v_t1, t), lerp(q.f0_t0, q.f0_t1, t),
+                                    lerp(q.f1_t0, q.f1_t1, t), lerp(q.f2_t0, q.f2_t1, t))
+        .distance;
+  });
+}
+
 double min_distance(const EdgeEdgeQuery& q) {
-  double d = INFINITY;
-  for (int i = 0; i <= kSamples; ++i) {
-    const double t = double(i) / kSamples;
-    auto at = [t](const V& a, const V& b) -> V { return a + t * (b - a); };
-    d = std::min(d, edge_edge_proximity(at(q.ea0_t0, q.ea0_t1), at(q.ea1_t0, q.ea1_t1),
-                                        at(q.eb0_t0, q.eb0_t1), at(q.eb1_t0, q.eb1_t1))
-                        .distance);
-  }
-  return d;
+  return sampled_min([&](double t) {
+    return edge_edge_proximity(lerp(q.ea0_t0, q.ea0_t1, t), lerp(q.ea1_t0, q.ea1_t1, t),
+                               lerp(q.eb0_t0, q.eb0_t1, t), lerp(q.eb1_t0, q.eb1_t1, t))
+        .distance;
+  });
 }
 
 // Features near each other (resting-contact-like gaps) with moves up to `move` per vertex.
