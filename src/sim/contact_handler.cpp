@@ -319,7 +319,7 @@ struct ContactHandler::Impl {
     proximity.clear();
     excluded = 0;
     body_swept = false;
-    if (has_body(ctx)) ensure_body(ctx);
+    if (has_body(ctx)) ensure_body(ctx);  // the crossing counter and the body queries need it
     find_crossings(ctx);
     const std::span<const Vec3> none;
     const double dh = opt.thickness;
@@ -346,7 +346,6 @@ struct ContactHandler::Impl {
       }
     }
     if (has_body(ctx)) {
-      ensure_body(ctx);
       RefitOptions ro;
       ro.cones = false;
       ro.thickness = dh;
