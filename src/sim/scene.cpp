@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -249,6 +250,18 @@ int SubstepRule::count(double body_displacement, double cloth_displacement_estim
   return n > max ? max : static_cast<int>(n);
 }
 
+double SubstepRule::cloth_speed(std::span<const Vec3> v) const {
+  if (v.empty()) return 0.0;
+  std::vector<double> s(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    s[i] = v[i].norm();
+  const double rank = std::ceil(cloth_speed_quantile * static_cast<double>(s.size()));
+  const std::size_t k = rank >= 1.0 ? static_cast<std::size_t>(rank) - 1 : 0;
+  const auto at = s.begin() + static_cast<std::ptrdiff_t>(std::min(k, s.size() - 1));
+  std::nth_element(s.begin(), at, s.end());
+  return *at;
+}
+
 std::filesystem::path data_root_for(const std::filesystem::path& scene_file) {
   if (const char* env = std::getenv("CLOTHCD_DATA"); env != nullptr && *env != '\0') return env;
   const std::filesystem::path dir = std::filesystem::absolute(scene_file).parent_path();
@@ -319,6 +332,8 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     s.substeps.displacement = o.number("displacement", s.substeps.displacement, 1e-9, 1e6);
     s.substeps.cloth_displacement =
         o.number("cloth_displacement", s.substeps.cloth_displacement, 0.0, 1e6);
+    s.substeps.cloth_speed_quantile =
+        o.number("cloth_speed_quantile", s.substeps.cloth_speed_quantile, 1e-6, 1.0);
     o.finish();
   }
   if (top.has("body")) {

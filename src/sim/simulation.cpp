@@ -50,9 +50,7 @@ FrameStats Simulation::advance_frame() {
   const double t1 = (frame_ + 1) * scene_.frame_dt;
   FrameStats fs;
   fs.body_displacement = scene_.body ? scene_.body->max_displacement(t0, t1) : 0.0;
-  double speed = 0.0;
-  for (const Vec3& v : state_.v)
-    speed = std::max(speed, v.norm());
+  const double speed = scene_.substeps.cloth_speed(state_.v);
   fs.substeps = scene_.substeps.count(fs.body_displacement, speed * scene_.frame_dt);
   const double h = scene_.frame_dt / fs.substeps;
   for (int k = 0; k < fs.substeps; ++k) {

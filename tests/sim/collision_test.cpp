@@ -2,6 +2,8 @@
 // gently, the body has infinite mass. (Whole scenes: collision_scenes_test.cpp.)
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/sim/contact_handler.hpp"
 #include "clothcd/sim/intersections.hpp"
@@ -166,6 +168,47 @@ TEST(ContactHandler, PairsAlreadyCrossingAreLeftOutNotFought) {
     EXPECT_GT(n.dot(s.x1[i] - s.x1[0]), 0.0);  // the falling triangle stays above
   // The crossing is gone or unchanged, and no new one appeared.
   EXPECT_LE(count.self_pairs(s.x1).size(), 1u);
+}
+
+TEST(ContactHandler, SqueezedStackIsResolvedByTheProjectionAlone) {
+  // Three horizontal squares 1 cm apart; the bottom one rises and the top one falls 1.5 cm in
+  // the substep, so both outer pairs cross the middle one. Pushing the middle sheet away from
+  // one neighbour pushes it into the other: the impulses must be found together, and the
+  // accumulated projection does that without falling back to impact zones.
+  ClothMeshInput in;
+  const std::array<double, 3> lo{0.0, 0.1, 0.2}, hi{1.0, 0.9, 0.8};
+  for (int k = 0; k < 3; ++k) {
+    const double y = 0.01 * k;
+    in.positions.insert(
+        in.positions.end(),
+        {{lo[k], y, lo[k]}, {hi[k], y, lo[k]}, {hi[k], y, hi[k]}, {lo[k], y, hi[k]}});
+    const int b = 4 * k;
+    in.faces.push_back({b, b + 2, b + 1});
+    in.faces.push_back({b, b + 3, b + 2});
+  }
+  const ClothModel m(in, ClothMaterial{});
+  std::vector<Vec3> v(12, Vec3::Zero());
+  for (int i = 0; i < 4; ++i) {
+    v[i] = Vec3(0.0, 1.5, 0.0);
+    v[8 + i] = Vec3(0.0, -1.5, 0.0);
+  }
+  const Vec3 p0 = momentum(m, v);
+  const OneStep s = one_step(m, v, 0.01);
+  EXPECT_GT(s.stats.ccd_hits, 0);
+  EXPECT_EQ(s.stats.zone_rounds, 0);
+  EXPECT_EQ(s.stats.unresolved, 0);
+  SelfDetector d(m.topology().faces(), 12, to_matrix(m.initial_positions()));
+  const DetectResult r = d.detect(to_matrix(m.initial_positions()), to_matrix(s.x1));
+  EXPECT_TRUE(r.vf.empty());
+  EXPECT_TRUE(r.ee.empty());
+  // The sheets end in their order at their common centre, which lies on each sheet's diagonal
+  // (their corners may tilt past each other outside the narrower sheets' footprint).
+  std::array<double, 3> y{};
+  for (int k = 0; k < 3; ++k)
+    y[k] = 0.5 * (s.x1[4 * k].y() + s.x1[4 * k + 2].y());
+  EXPECT_LT(y[0], y[1]);
+  EXPECT_LT(y[1], y[2]);
+  EXPECT_LT((momentum(m, s.v) - p0).norm(), 1e-12);
 }
 
 }  // namespace

@@ -129,6 +129,21 @@ TEST(Scene, SubstepRule) {
   EXPECT_EQ(r.count(10.0), 32);
 }
 
+TEST(Scene, ClothSpeedQuantileIgnoresTheFewFastestVertices) {
+  std::vector<Vec3> v(2000, Vec3(0.0, 0.1, 0.0));
+  v[7] = Vec3(3.0, 0.0, 4.0);  // one vertex at 5 m/s
+  v[1500] = Vec3(0.0, -0.3, 0.0);
+  SubstepRule r;
+  EXPECT_DOUBLE_EQ(r.cloth_speed(v), 5.0);  // default: the fastest
+  r.cloth_speed_quantile = 0.9985;          // rank 1997 of 2000
+  EXPECT_DOUBLE_EQ(r.cloth_speed(v), 0.1);
+  r.cloth_speed_quantile = 0.99949;  // rank 1999: the second fastest
+  EXPECT_DOUBLE_EQ(r.cloth_speed(v), 0.3);
+  r.cloth_speed_quantile = 1e-6;  // the slowest
+  EXPECT_DOUBLE_EQ(r.cloth_speed(v), 0.1);
+  EXPECT_DOUBLE_EQ(r.cloth_speed({}), 0.0);
+}
+
 std::filesystem::path repo_scene(const char* name) {
   return std::filesystem::path(CLOTHCD_SOURCE_DIR) / "scenes" / name;
 }
