@@ -1,14 +1,11 @@
-// Collision response: proximity repulsion + friction, CCD impulse passes, rigid impact zones.
+// Collision response: proximity repulsion + friction, CCD passes with inelastic projection,
+// rigid impact zones.
 #include "clothcd/sim/contact_handler.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <limits>
 #include <numeric>
 #include <optional>
 

@@ -1,12 +1,14 @@
 #pragma once
 /// @file
 /// The collision stage (docs/simulator.md 3; reference ../shared/docs/simulator.md 3): per
-/// substep, proximity repulsion and friction within the cloth thickness, then CCD passes with
-/// inelastic pair impulses (Bridson, Fedkiw, Anderson 2002), then rigid impact zones (Provot 1997)
-/// as the fail-safe. Cloth self contact goes through clothcd::SelfDetector (sound culling only),
-/// cloth-body CCD through clothcd::PairDetector. Body vertices have infinite mass, and so have
-/// pinned cloth vertices. Processing is sequential over sorted pairs, so results do not depend on
-/// the thread count.
+/// substep, proximity repulsion and friction within the cloth thickness, then CCD passes whose
+/// hits accumulate as linearized constraints that projected Gauss-Seidel satisfies together
+/// (inelastic projection, Harmon et al. 2008; the impulses are those of Bridson, Fedkiw,
+/// Anderson 2002), then rigid impact zones (Provot 1997) as the fail-safe. Cloth self contact
+/// goes through clothcd::SelfDetector (sound culling only), cloth-body contact through clothcd
+/// BVHs of both meshes and the conservative CCD kernels. Body vertices have infinite mass, and so
+/// have pinned cloth vertices. Processing is sequential over sorted pairs, so results do not
+/// depend on the thread count.
 
 #include <memory>
 #include <span>
@@ -21,7 +23,7 @@ struct ContactOptions {
   bool body = true;             ///< cloth-body contact
   double thickness = 1e-3;      ///< repulsion distance d-hat (m)
   double ccd_thickness = 1e-5;  ///< minimum separation the CCD keeps (m)
-  int ccd_iterations = 5;       ///< impulse passes before impact zones
+  int ccd_iterations = 5;       ///< CCD passes (each followed by the projection) before zones
   int zone_rounds = 30;         ///< impact-zone rounds before giving up
   /// Share of the overlap d-hat - d that repulsion removes per substep.
   double repulsion_fraction = 0.1;
