@@ -914,12 +914,10 @@ struct ContactHandler::Impl {
         zone_of[i] = root_zone[r];
         members[zone_of[i]].push_back(i);
       }
-      std::vector<Vec3> anchor_sum(members.size(), Vec3::Zero());
-      std::vector<int> anchor_count(members.size(), 0);
+      std::vector<int> anchor_count(members.size(), 0);  // > 0: the zone is anchored
       std::fill(vertex_anchor_sum.begin(), vertex_anchor_sum.end(), Vec3::Zero());
       std::fill(vertex_anchor_count.begin(), vertex_anchor_count.end(), 0);
       for (const auto& [i, vel] : anchors) {
-        anchor_sum[zone_of[i]] += vel;
         ++anchor_count[zone_of[i]];
         vertex_anchor_sum[i] += vel;
         ++vertex_anchor_count[i];
@@ -931,10 +929,7 @@ struct ContactHandler::Impl {
         st.largest_zone = std::max(st.largest_zone, static_cast<int>(m.size()));
         for (int i : m) {
           changed[i] = 1;
-          if (inv_mass[i] == 0.0) {
-            anchor_sum[z] += v[i];
-            ++anchor_count[z];
-          }
+          if (inv_mass[i] == 0.0) ++anchor_count[z];
         }
         // The zone moves rigidly (an invertible linear map of its start positions over the
         // substep, so nothing inside it can collide): free zones keep their momentum and angular
