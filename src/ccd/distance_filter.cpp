@@ -34,26 +34,52 @@ bool culls(double d0, double d1, double move, double thickness, double eps) {
   return std::isfinite(bound) && bound > thickness + eps;
 }
 
+// The bound on [ta, tb] (distances da, db at its ends), bisected up to `depth` times where it
+// fails: the distance is Lipschitz with constant `move` on any part of the step, so each half
+// needs only its own end distances. `dist(t)` is the distance at time t.
+template <class Dist>
+bool culls_on(double ta, double tb, double da, double db, double move, double thickness, double eps,
+              int depth, Dist&& dist) {
+  if (culls(da, db, move * (tb - ta), thickness, eps)) return true;
+  if (depth <= 0 || !(std::min(da, db) > thickness + eps)) return false;
+  const double tm = 0.5 * (ta + tb);
+  const double dm = dist(tm);
+  return culls_on(ta, tm, da, dm, move, thickness, eps, depth - 1, dist) &&
+         culls_on(tm, tb, dm, db, move, thickness, eps, depth - 1, dist);
+}
+
+Vec3 at(const Vec3& x0, const Vec3& x1, double t) {
+  return x0 + t * (x1 - x0);
+}
+
 }  // namespace
 
-bool distance_filter_culls(const VertexFaceQuery& q, double thickness) {
+bool distance_filter_culls(const VertexFaceQuery& q, double thickness, int depth) {
   const double d0 = point_triangle_proximity(q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0).distance;
   const double d1 = point_triangle_proximity(q.v_t1, q.f0_t1, q.f1_t1, q.f2_t1).distance;
   const double move = largest_relative_move(
       {q.v_t1 - q.v_t0}, {q.f0_t1 - q.f0_t0, q.f1_t1 - q.f1_t0, q.f2_t1 - q.f2_t0});
-  return culls(
-      d0, d1, move, thickness,
-      slack({&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0, &q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1}));
+  const double eps =
+      slack({&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0, &q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1});
+  return culls_on(0.0, 1.0, d0, d1, move, thickness, eps, depth, [&](double t) {
+    return point_triangle_proximity(at(q.v_t0, q.v_t1, t), at(q.f0_t0, q.f0_t1, t),
+                                    at(q.f1_t0, q.f1_t1, t), at(q.f2_t0, q.f2_t1, t))
+        .distance;
+  });
 }
 
-bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness) {
+bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness, int depth) {
   const double d0 = edge_edge_proximity(q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0).distance;
   const double d1 = edge_edge_proximity(q.ea0_t1, q.ea1_t1, q.eb0_t1, q.eb1_t1).distance;
   const double move = largest_relative_move({q.ea0_t1 - q.ea0_t0, q.ea1_t1 - q.ea1_t0},
                                             {q.eb0_t1 - q.eb0_t0, q.eb1_t1 - q.eb1_t0});
-  return culls(d0, d1, move, thickness,
-               slack({&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0, &q.ea0_t1, &q.ea1_t1, &q.eb0_t1,
-                      &q.eb1_t1}));
+  const double eps = slack(
+      {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0, &q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1});
+  return culls_on(0.0, 1.0, d0, d1, move, thickness, eps, depth, [&](double t) {
+    return edge_edge_proximity(at(q.ea0_t0, q.ea0_t1, t), at(q.ea1_t0, q.ea1_t1, t),
+                               at(q.eb0_t0, q.eb0_t1, t), at(q.eb1_t0, q.eb1_t1, t))
+        .distance;
+  });
 }
 
 }  // namespace clothcd

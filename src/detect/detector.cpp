@@ -138,6 +138,8 @@ struct SelfDetector::Impl {
     ctx.np_filter = opt.np_filter;
     ctx.ccd = CcdOptions{opt.thickness, opt.fast_path};
     ctx.ccd.toi_tolerance = opt.toi_tolerance;
+    ctx.ccd.tolerance = opt.ccd_tolerance;
+    ctx.distance_depth = opt.distance_filter_depth;
     ctx.links = links;
     detail::precompute_boxes(ctx, vboxes, eboxes, fboxes);
     tbb::enumerable_thread_specific<NarrowBuffer> locals;
@@ -344,6 +346,34 @@ struct SelfDetector::Impl {
       for (int v : topo.faces()[f])
         touch[f] |= vertex_active[v];
     }
+    set_nodes(touch);
+  }
+
+  // Scope by vertices: a VF pair when its vertex or a vertex of its face is active, an EE pair
+  // when an endpoint is active. A face then counts as active when it has an active vertex, and
+  // only such faces can represent an in-scope pair.
+  void set_active_vertices(std::span<const int> active_vertices) {
+    const int nv = topo.num_vertices();
+    vertex_active.assign(nv, 0);
+    for (int v : active_vertices) {
+      if (v < 0 || v >= nv) {
+        throw InputError(fmt::format("active vertex {} is out of range [0, {})", v, nv));
+      }
+      vertex_active[v] = 1;
+    }
+    face_active.assign(topo.num_faces(), 0);
+    for (int f = 0; f < topo.num_faces(); ++f) {
+      for (int v : topo.faces()[f])
+        face_active[f] |= vertex_active[v];
+    }
+    edge_active.assign(topo.num_edges(), 0);
+    for (int e = 0; e < topo.num_edges(); ++e)
+      edge_active[e] = vertex_active[topo.edges()[e][0]] | vertex_active[topo.edges()[e][1]];
+    set_nodes(face_active);
+  }
+
+  // Nodes holding a face that can represent an in-scope pair (children follow their parent).
+  void set_nodes(const std::vector<std::uint8_t>& touch) {
     const auto& nodes = bvh.nodes();
     node_active.assign(nodes.size(), 0);
     for (int i = static_cast<int>(nodes.size()) - 1; i >= 0; --i) {
@@ -370,6 +400,9 @@ ProximityResult SelfDetector::proximity(const Positions& v, double h) {
 }
 void SelfDetector::set_active_faces(std::span<const int> faces) {
   impl_->set_active(faces);
+}
+void SelfDetector::set_active_vertices(std::span<const int> vertices) {
+  impl_->set_active_vertices(vertices);
 }
 void SelfDetector::clear_active_faces() {
   impl_->restricted = false;

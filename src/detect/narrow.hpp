@@ -79,6 +79,7 @@ struct FeatureContext {
   std::span<const Eigen::Vector3d> v0, v1;
   double margin = 0;  // thickness / 2
   bool np_filter = true;
+  int distance_depth = 0;  // DetectOptions::distance_filter_depth
   CcdOptions ccd;
   /// Optional swept boxes of every vertex, edge and face for this step (`precompute_boxes`);
   /// empty: computed on demand.
@@ -119,7 +120,7 @@ struct FeatureContext {
     const VertexFaceQuery q{v0[v], v0[t[0]], v0[t[1]], v0[t[2]],
                             v1[v], v1[t[0]], v1[t[1]], v1[t[2]]};
     if ((separate_np() && np_filter_culls(q)) ||
-        (distance_filter() && distance_filter_culls(q, ccd.thickness))) {
+        (distance_filter() && distance_filter_culls(q, ccd.thickness, distance_depth))) {
       ++c.vf_np;
       return;
     }
@@ -139,7 +140,7 @@ struct FeatureContext {
     const EdgeEdgeQuery q{v0[a[0]], v0[a[1]], v0[b[0]], v0[b[1]],
                           v1[a[0]], v1[a[1]], v1[b[0]], v1[b[1]]};
     if ((separate_np() && np_filter_culls(q)) ||
-        (distance_filter() && distance_filter_culls(q, ccd.thickness))) {
+        (distance_filter() && distance_filter_culls(q, ccd.thickness, distance_depth))) {
       ++c.ee_np;
       return;
     }

@@ -2,6 +2,8 @@
 // Overlapping leaf pairs of clothcd BVHs (static or swept boxes, refit by the caller), for the
 // simulator's proximity queries against the body and its intersection counts.
 
+#include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -10,9 +12,11 @@
 namespace clothcd::sim::detail {
 
 /// Calls fn(face_a, face_b) for every pair of a leaf below node `i` of `a` and a leaf below node
-/// `j` of `b` whose boxes overlap.
+/// `j` of `b` whose boxes overlap; with `a_mask` (one flag per node of `a`), only below nodes of
+/// `a` whose flag is set.
 template <class Fn>
-void for_each_overlap_below(const Bvh& a, int i0, const Bvh& b, int j0, Fn&& fn) {
+void for_each_overlap_below(const Bvh& a, int i0, const Bvh& b, int j0, Fn&& fn,
+                            std::span<const std::uint8_t> a_mask = {}) {
   const auto& na = a.nodes();
   const auto& nb = b.nodes();
   std::vector<std::pair<int, int>> stack{{i0, j0}};
@@ -21,6 +25,7 @@ void for_each_overlap_below(const Bvh& a, int i0, const Bvh& b, int j0, Fn&& fn)
     stack.pop_back();
     const BvhNode& x = na[i];
     const BvhNode& y = nb[j];
+    if (!a_mask.empty() && !a_mask[i]) continue;
     if (!overlap(x, y)) continue;
     if (x.is_leaf() && y.is_leaf()) {
       fn(a.prim_ids()[x.first], b.prim_ids()[y.first]);
@@ -34,11 +39,13 @@ void for_each_overlap_below(const Bvh& a, int i0, const Bvh& b, int j0, Fn&& fn)
   }
 }
 
-/// Calls fn(face_a, face_b) for every pair of leaves of `a` and `b` whose boxes overlap.
+/// Calls fn(face_a, face_b) for every pair of leaves of `a` and `b` whose boxes overlap (below
+/// flagged nodes of `a` only, when `a_mask` is given).
 template <class Fn>
-void for_each_overlap(const Bvh& a, const Bvh& b, Fn&& fn) {
+void for_each_overlap(const Bvh& a, const Bvh& b, Fn&& fn,
+                      std::span<const std::uint8_t> a_mask = {}) {
   if (a.nodes().empty() || b.nodes().empty()) return;
-  for_each_overlap_below(a, 0, b, 0, fn);
+  for_each_overlap_below(a, 0, b, 0, fn, a_mask);
 }
 
 /// Calls fn(f, g) once for every unordered pair of distinct leaves of `a` whose boxes overlap:

@@ -263,6 +263,8 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                              {"ccd_thickness", c.ccd_thickness},
                              {"ccd_iterations", c.ccd_iterations},
                              {"zone_rounds", c.zone_rounds},
+                             {"repulsion_fraction", c.repulsion_fraction},
+                             {"repulsion_sweeps", c.repulsion_sweeps},
                              {"friction", c.friction}};
     }
     if (scene.count_intersections) {

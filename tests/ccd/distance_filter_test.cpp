@@ -56,29 +56,55 @@ struct Generator {
 };
 
 TEST(DistanceFilter, NeverCullsAPairThatComesWithinTheThickness) {
-  int culled_vf = 0, culled_ee = 0, cases = 0;
-  for (double scale : {1e-3, 1e-2, 1.0}) {
-    for (double move_ratio : {0.01, 0.1, 1.0}) {
-      Generator g{std::mt19937_64(17), scale, move_ratio * scale};
-      for (int i = 0; i < 300; ++i, ++cases) {
-        const double thickness = scale * std::pow(10.0, -1 - 3 * (i % 4) / 3.0);
-        const V a = g.point(), b = g.point(), c = g.point(), d = g.point();
-        const VertexFaceQuery vf{a, b, c, d, g.step(a), g.step(b), g.step(c), g.step(d)};
-        if (distance_filter_culls(vf, thickness)) {
-          ++culled_vf;
-          ASSERT_GT(min_distance(vf), thickness) << "scale " << scale << " case " << i;
-        }
-        const EdgeEdgeQuery ee{a, b, c, d, g.step(a), g.step(b), g.step(c), g.step(d)};
-        if (distance_filter_culls(ee, thickness)) {
-          ++culled_ee;
-          ASSERT_GT(min_distance(ee), thickness) << "scale " << scale << " case " << i;
+  // Depth 0 is the whole-step bound; deeper filters bisect the step where it fails.
+  for (int depth : {0, 3, 6}) {
+    int culled_vf = 0, culled_ee = 0, cases = 0;
+    for (double scale : {1e-3, 1e-2, 1.0}) {
+      for (double move_ratio : {0.01, 0.1, 1.0}) {
+        Generator g{std::mt19937_64(17), scale, move_ratio * scale};
+        for (int i = 0; i < 300; ++i, ++cases) {
+          const double thickness = scale * std::pow(10.0, -1 - 3 * (i % 4) / 3.0);
+          const V a = g.point(), b = g.point(), c = g.point(), d = g.point();
+          const VertexFaceQuery vf{a, b, c, d, g.step(a), g.step(b), g.step(c), g.step(d)};
+          if (distance_filter_culls(vf, thickness, depth)) {
+            ++culled_vf;
+            ASSERT_GT(min_distance(vf), thickness)
+                << "depth " << depth << " scale " << scale << " case " << i;
+          } else {
+            // Bisection only adds culls.
+            ASSERT_FALSE(distance_filter_culls(vf, thickness));
+          }
+          const EdgeEdgeQuery ee{a, b, c, d, g.step(a), g.step(b), g.step(c), g.step(d)};
+          if (distance_filter_culls(ee, thickness, depth)) {
+            ++culled_ee;
+            ASSERT_GT(min_distance(ee), thickness)
+                << "depth " << depth << " scale " << scale << " case " << i;
+          } else {
+            ASSERT_FALSE(distance_filter_culls(ee, thickness));
+          }
         }
       }
     }
+    // The filter must also do its job: small relative moves are culled often.
+    EXPECT_GT(culled_vf, cases / 4) << "depth " << depth;
+    EXPECT_GT(culled_ee, cases / 4) << "depth " << depth;
   }
-  // The filter must also do its job: small relative moves are culled often.
-  EXPECT_GT(culled_vf, cases / 4);
-  EXPECT_GT(culled_ee, cases / 4);
+}
+
+TEST(DistanceFilter, BisectionCullsANearMissTheWholeStepBoundCannot) {
+  // A vertex slides 5 cm across a face 1 mm above it: the whole-step bound (1 + 1 - 50) / 2 mm
+  // proves nothing, 1/64 of the step moves it 0.8 mm < 2 (1 - 0.01) mm.
+  const V a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  const VertexFaceQuery vf{V(0.2, 0.2, 0.001), a, b, c, V(0.25, 0.2, 0.001), a, b, c};
+  EXPECT_FALSE(distance_filter_culls(vf, 1e-5));
+  EXPECT_FALSE(distance_filter_culls(vf, 1e-5, 4));
+  EXPECT_TRUE(distance_filter_culls(vf, 1e-5, 6));
+  EXPECT_FALSE(distance_filter_culls(vf, 0.0011, 10));  // thicker than the gap
+  // An edge sliding along another 1 mm above it.
+  const EdgeEdgeQuery ee{V(0.5, -1, 0.001),  V(0.5, 1, 0.001),  a, b,
+                         V(0.55, -1, 0.001), V(0.55, 1, 0.001), a, b};
+  EXPECT_FALSE(distance_filter_culls(ee, 1e-5));
+  EXPECT_TRUE(distance_filter_culls(ee, 1e-5, 6));
 }
 
 TEST(DistanceFilter, RestingPairMovingTogetherIsCulled) {

@@ -110,6 +110,55 @@ TEST(DetectApi, ActiveFacesEqualFilteredBruteForce) {
   }
 }
 
+TEST(DetectApi, ActiveVerticesEqualFilteredBruteForce) {
+  for (const auto& s : {crumpled_sheet(8, 3), twisted_strip(30, 3)}) {
+    const Topology topo(s.faces, s.num_vertices);
+    // Every fifth vertex, and a contiguous block: both sparse and clustered sets.
+    std::vector<int> active;
+    std::vector<std::uint8_t> on(s.num_vertices, 0);
+    for (int v = 0; v < s.num_vertices; ++v) {
+      if (v % 5 == 0 || (v > s.num_vertices / 2 && v < s.num_vertices / 2 + 15)) {
+        active.push_back(v);
+        on[v] = 1;
+      }
+    }
+    // The oracle: every pair of the full brute force with an active vertex.
+    const DetectResult full = brute_force_detect(topo, s.v_t0, s.v_t1);
+    DetectResult ref;
+    for (const auto& c : full.vf) {
+      const Face& f = c.face_vertices;
+      if (on[c.vertex] || on[f[0]] || on[f[1]] || on[f[2]]) ref.vf.push_back(c);
+    }
+    for (const auto& c : full.ee) {
+      const Edge &a = c.edge_a_vertices, &b = c.edge_b_vertices;
+      if (on[a[0]] || on[a[1]] || on[b[0]] || on[b[1]]) ref.ee.push_back(c);
+    }
+    EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u) << s.name;
+    EXPECT_LT(ref.vf.size() + ref.ee.size(), full.vf.size() + full.ee.size()) << s.name;
+    for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+      for (Culling culling : {Culling::None, Culling::Sound}) {
+        SCOPED_TRACE(::testing::Message()
+                     << s.name << " build " << int(build) << " culling " << int(culling));
+        DetectOptions o;
+        o.build = build;
+        o.culling = culling;
+        SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+        det.set_active_vertices(active);
+        const DetectResult r = det.detect(s.v_t0, s.v_t1);
+        EXPECT_EQ(r.vf, ref.vf);
+        EXPECT_EQ(r.ee, ref.ee);
+        det.clear_active_faces();
+        const DetectResult all = det.detect(s.v_t0, s.v_t1);
+        EXPECT_EQ(all.vf, full.vf);
+        EXPECT_EQ(all.ee, full.ee);
+      }
+    }
+    SelfDetector det(s.faces, s.num_vertices, s.v_t0, {});
+    const std::vector<int> bad{0, s.num_vertices};
+    EXPECT_THROW(det.set_active_vertices(bad), InputError);
+  }
+}
+
 // Every counter of a detection (times excluded).
 std::vector<std::uint64_t> counters(const DetectStats& s) {
   return {s.box_tests,

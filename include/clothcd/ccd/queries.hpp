@@ -78,9 +78,12 @@ struct CcdResult {
 /// `thickness` during the whole motion. The distance is Lipschitz in t with constant D, the largest
 /// relative displacement of a vertex of one feature against a vertex of the other, so it never
 /// drops below (d0 + d1 - D) / 2 (d0, d1: the distances at both ends; docs/ccd.md). Cheap for
-/// resting contact, where the cubic filter cannot help because thickness > 0. NaN or infinite
-/// coordinates throw std::invalid_argument.
-[[nodiscard]] bool distance_filter_culls(const VertexFaceQuery& q, double thickness);
-[[nodiscard]] bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness);
+/// resting contact, where the cubic filter cannot help because thickness > 0. With `depth` > 0
+/// the step is bisected (up to depth times, only where the bound fails and the distance at the
+/// new instant still exceeds the thickness) and the bound applied to each part with its own end
+/// distances: up to 2^depth + 1 distance evaluations that cull near misses the whole-step bound
+/// cannot. NaN or infinite coordinates throw std::invalid_argument.
+[[nodiscard]] bool distance_filter_culls(const VertexFaceQuery& q, double thickness, int depth = 0);
+[[nodiscard]] bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness, int depth = 0);
 
 }  // namespace clothcd

@@ -50,6 +50,9 @@ class SelfDetector {
 
   /// Restricts detection to pairs in which at least one feature belongs to an active triangle.
   void set_active_faces(std::span<const int> faces);
+  /// Restricts detection to pairs in which at least one vertex is active: exactly the pairs whose
+  /// motion changes when only the active vertices move (a simulator's passes after the first).
+  void set_active_vertices(std::span<const int> vertices);
   void clear_active_faces();
 
   [[nodiscard]] const DetectOptions& options() const;

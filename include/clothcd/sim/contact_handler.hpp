@@ -27,6 +27,9 @@ struct ContactOptions {
   int zone_rounds = 30;         ///< impact-zone rounds before giving up
   /// Share of the overlap d-hat - d that repulsion removes per substep.
   double repulsion_fraction = 0.1;
+  /// Gauss-Seidel sweeps of the repulsion impulses (the first one also applies friction). On
+  /// multilayer-kick frames 1-3, 20 instead of 1 left 31,521 instead of 154,054 CCD hits.
+  int repulsion_sweeps = 20;
   double friction = 0.2;  ///< Coulomb coefficient of the contact impulses
 };
 
