@@ -819,7 +819,8 @@ struct ContactHandler::Impl {
     lambda.clear();
     bool clean = false;
     for (int pass = 0; pass < opt.ccd_iterations; ++pass) {
-      const std::vector<Contact> hs = hits(ctx, v, pass == 0 ? nullptr : &active);
+      const std::vector<Contact> hs =
+          hits(ctx, v, pass == 0 || opt.full_passes ? nullptr : &active);
       ++st.ccd_passes;
       st.ccd_hits += static_cast<long long>(hs.size());
       if (hs.empty()) {
@@ -922,7 +923,7 @@ struct ContactHandler::Impl {
     // frames 38-43 had 0 / 0 / 0 / 0 / 5 / 5 crossing pairs without it, 171 by frame 41 with it.)
     for (int round = 0;; ++round) {
       sep_scale = round >= std::min(kMarginRounds, opt.zone_rounds / 2) ? 0.0 : 1.0;
-      const std::vector<Contact> hs = hits(ctx, v, &active);
+      const std::vector<Contact> hs = hits(ctx, v, opt.full_passes ? nullptr : &active);
       if (hs.empty()) break;
       if (round == opt.zone_rounds) {
         st.unresolved = static_cast<long long>(hs.size());

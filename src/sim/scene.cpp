@@ -426,6 +426,7 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     c.zone_rounds = o.integer("zone_rounds", c.zone_rounds, 0, 10000);
     c.repulsion_fraction = o.number("repulsion_fraction", c.repulsion_fraction, 0.0, 1.0);
     c.repulsion_sweeps = o.integer("repulsion_sweeps", c.repulsion_sweeps, 1, 1000);
+    c.full_passes = boolean("full_passes", c.full_passes);
     s.count_intersections = boolean("count_intersections", s.count_intersections);
     o.finish();
   }

@@ -30,6 +30,11 @@ struct ContactOptions {
   /// Gauss-Seidel sweeps of the repulsion impulses (the first one also applies friction). On
   /// multilayer-kick frames 1-3, 20 instead of 1 left 31,521 instead of 154,054 CCD hits.
   int repulsion_sweeps = 20;
+  /// Every CCD pass and zone round tests every pair (diagnostic). By default, passes after the
+  /// first test only pairs with a vertex whose velocity the last response changed or that was in
+  /// the last pass's hits: every other pair keeps a motion already tested without a hit, so
+  /// both give bitwise the same result (tested).
+  bool full_passes = false;
   double friction = 0.2;  ///< Coulomb coefficient of the contact impulses
 };
 
