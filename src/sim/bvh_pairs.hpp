@@ -2,6 +2,10 @@
 // Overlapping leaf pairs of clothcd BVHs (static or swept boxes, refit by the caller), for the
 // simulator's proximity queries against the body and its intersection counts.
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -46,6 +50,49 @@ void for_each_overlap(const Bvh& a, const Bvh& b, Fn&& fn,
                       std::span<const std::uint8_t> a_mask = {}) {
   if (a.nodes().empty() || b.nodes().empty()) return;
   for_each_overlap_below(a, 0, b, 0, fn, a_mask);
+}
+
+/// Like for_each_overlap, in parallel: fn(face_a, face_b, local) with the calling thread's
+/// `Local` from `locals`. The calls come in no fixed order: callers merge and sort.
+template <class Local, class Fn>
+void for_each_overlap_parallel(const Bvh& a, const Bvh& b,
+                               tbb::enumerable_thread_specific<Local>& locals, Fn&& fn,
+                               std::span<const std::uint8_t> a_mask = {}) {
+  const auto& na = a.nodes();
+  const auto& nb = b.nodes();
+  if (na.empty() || nb.empty()) return;
+  // Breadth-first to a frontier of node pairs, then each pair's subtrees as one task.
+  constexpr std::size_t kTasks = 256;
+  std::vector<std::pair<int, int>> frontier{{0, 0}}, next;
+  Local& serial = locals.local();
+  while (!frontier.empty() && frontier.size() < kTasks) {
+    next.clear();
+    for (const auto [i, j] : frontier) {
+      if (!a_mask.empty() && !a_mask[i]) continue;
+      const BvhNode& x = na[i];
+      const BvhNode& y = nb[j];
+      if (!overlap(x, y)) continue;
+      if (x.is_leaf() && y.is_leaf()) {
+        fn(a.prim_ids()[x.first], b.prim_ids()[y.first], serial);
+      } else if (y.is_leaf() || (!x.is_leaf() && x.count >= y.count)) {
+        next.emplace_back(x.left, j);
+        next.emplace_back(x.left + 1, j);
+      } else {
+        next.emplace_back(i, y.left);
+        next.emplace_back(i, y.left + 1);
+      }
+    }
+    frontier.swap(next);
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, frontier.size(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      Local& local = locals.local();
+                      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                        for_each_overlap_below(
+                            a, frontier[k].first, b, frontier[k].second,
+                            [&](int f, int g) { fn(f, g, local); }, a_mask);
+                      }
+                    });
 }
 
 /// Calls fn(f, g) once for every unordered pair of distinct leaves of `a` whose boxes overlap:

@@ -10,7 +10,9 @@
 #include <optional>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "bvh_pairs.hpp"
 #include "clothcd/bvh/bvh.hpp"
@@ -116,6 +118,25 @@ class UnionFind {
  private:
   std::vector<int> parent_;
 };
+
+// Cloth-body feature pairs of one query: (cloth vertex, body face), (body vertex, cloth face),
+// (cloth edge, body edge).
+struct BodyPairs {
+  std::vector<std::pair<int, int>> vf_cb, vf_bc, ee;
+};
+
+// The threads' lists merged, sorted and without duplicates: the same lists for any thread count.
+BodyPairs merge(tbb::enumerable_thread_specific<BodyPairs>& locals) {
+  BodyPairs out;
+  for (auto m : {&BodyPairs::vf_cb, &BodyPairs::vf_bc, &BodyPairs::ee}) {
+    auto& l = out.*m;
+    for (const BodyPairs& p : locals)
+      l.insert(l.end(), (p.*m).begin(), (p.*m).end());
+    tbb::parallel_sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -408,7 +429,6 @@ struct ContactHandler::Impl {
       ro.thickness = dh;
       cloth_bvh.refit(x0, ro);
       body_bvh.refit(b0, ro);
-      std::vector<std::pair<int, int>> vf_cb, vf_bc, ee;
       const auto& cf = model.topology().faces();
       const auto& bf = body_topo->faces();
       const auto& ce = model.topology().edges();
@@ -426,28 +446,32 @@ struct ContactHandler::Impl {
           hi = hi.cwiseMax(x[i]);
         }
       };
-      detail::for_each_overlap(cloth_bvh, body_bvh, [&](int f, int g) {
-        Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
-        box(x0, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
-        box(b0, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
-        for (int v : cf[f]) {
-          if (near(x0[v], x0[v], glo, ghi)) vf_cb.emplace_back(v, g);
-        }
-        for (int u : bf[g]) {
-          if (near(b0[u], b0[u], flo, fhi)) vf_bc.emplace_back(u, f);
-        }
-        for (int a : model.topology().face_edges(f)) {
-          box(x0, {ce[a][0], ce[a][1]}, lo, hi);
-          for (int b : body_topo->face_edges(g)) {
-            box(b0, {be[b][0], be[b][1]}, lo2, hi2);
-            if (near(lo, hi, lo2, hi2)) ee.emplace_back(a, b);
-          }
-        }
-      });
-      for (auto* l : {&vf_cb, &vf_bc, &ee}) {
-        std::sort(l->begin(), l->end());
-        l->erase(std::unique(l->begin(), l->end()), l->end());
-      }
+      tbb::enumerable_thread_specific<BodyPairs> locals;
+      detail::for_each_overlap_parallel(cloth_bvh, body_bvh, locals,
+                                        [&](int f, int g, BodyPairs& out) {
+                                          Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
+                                          box(x0, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
+                                          box(b0, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
+                                          for (int v : cf[f]) {
+                                            if (near(x0[v], x0[v], glo, ghi))
+                                              out.vf_cb.emplace_back(v, g);
+                                          }
+                                          for (int u : bf[g]) {
+                                            if (near(b0[u], b0[u], flo, fhi))
+                                              out.vf_bc.emplace_back(u, f);
+                                          }
+                                          for (int a : model.topology().face_edges(f)) {
+                                            box(x0, {ce[a][0], ce[a][1]}, lo, hi);
+                                            for (int b : body_topo->face_edges(g)) {
+                                              box(b0, {be[b][0], be[b][1]}, lo2, hi2);
+                                              if (near(lo, hi, lo2, hi2)) out.ee.emplace_back(a, b);
+                                            }
+                                          }
+                                        });
+      const BodyPairs pairs = merge(locals);
+      const auto& vf_cb = pairs.vf_cb;
+      const auto& vf_bc = pairs.vf_bc;
+      const auto& ee = pairs.ee;
       // Distances in parallel into flags; contacts are then built in the sorted order.
       auto within = [&](const std::vector<std::pair<int, int>>& l, auto&& dist) {
         std::vector<std::uint8_t> keep(l.size(), 0);
@@ -630,39 +654,37 @@ struct ContactHandler::Impl {
       return (lo_a.array() <= hi_b.array() + sep).all() &&
              (lo_b.array() <= hi_a.array() + sep).all();
     };
-    std::vector<std::pair<int, int>> vf_cb, vf_bc, ee;
     const std::span<const Vec3> x1s = x1;
-    auto visit = [&](int f, int g) {
+    auto visit = [&](int f, int g, BodyPairs& out) {
       Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
       swept(x0, x1s, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
       swept(b0, b1, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
       for (int i : cf[f]) {
         if (!vertex_flag[i]) continue;
         swept(x0, x1s, {i}, lo, hi);
-        if (near(lo, hi, glo, ghi)) vf_cb.emplace_back(i, g);
+        if (near(lo, hi, glo, ghi)) out.vf_cb.emplace_back(i, g);
       }
       for (int u : bf[g]) {
         swept(b0, b1, {u}, lo, hi);
-        if (near(lo, hi, flo, fhi)) vf_bc.emplace_back(u, f);
+        if (near(lo, hi, flo, fhi)) out.vf_bc.emplace_back(u, f);
       }
       for (int a : model.topology().face_edges(f)) {
         if (!edge_flag[a]) continue;
         swept(x0, x1s, {ce[a][0], ce[a][1]}, lo, hi);
         for (int b : body_topo->face_edges(g)) {
           swept(b0, b1, {be[b][0], be[b][1]}, lo2, hi2);
-          if (near(lo, hi, lo2, hi2)) ee.emplace_back(a, b);
+          if (near(lo, hi, lo2, hi2)) out.ee.emplace_back(a, b);
         }
       }
     };
-    if (active == nullptr) {
-      detail::for_each_overlap(cloth_bvh, body_bvh, visit);
-    } else {
-      detail::for_each_overlap(cloth_bvh, body_bvh, visit, node_flag);
-    }
-    for (auto* l : {&vf_cb, &vf_bc, &ee}) {
-      std::sort(l->begin(), l->end());
-      l->erase(std::unique(l->begin(), l->end()), l->end());
-    }
+    tbb::enumerable_thread_specific<BodyPairs> locals;
+    detail::for_each_overlap_parallel(cloth_bvh, body_bvh, locals, visit,
+                                      active == nullptr ? std::span<const std::uint8_t>{}
+                                                        : std::span<const std::uint8_t>(node_flag));
+    const BodyPairs pairs = merge(locals);
+    const auto& vf_cb = pairs.vf_cb;
+    const auto& vf_bc = pairs.vf_bc;
+    const auto& ee = pairs.ee;
     // Each test gives (toi or -1 for none or -2 for tangled, separation used).
     struct Outcome {
       double toi = -1.0;
