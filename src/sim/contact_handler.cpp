@@ -172,8 +172,18 @@ struct ContactHandler::Impl {
   // filling every pass and zone round with hits that no velocity can remove.
   std::optional<IntersectionCounter> crossing;
   std::vector<std::pair<int, int>> crossing_self, crossing_body;
-  bool clean_end = false;         // the last substep provably ended crossing-free ...
-  std::vector<Vec3> expected_x0;  // ... at these positions
+  // Cloth vertices inside the body (behind a body face that one of their faces crosses): each
+  // moves out along that face's outward normal, `push` metres still to go (see untangle()).
+  struct Escape {
+    int vertex = -1;
+    int body_face = -1;
+    Vec3 n = Vec3::Zero();
+    double push = 0.0;
+  };
+  std::vector<Escape> escapes;
+  std::vector<std::uint8_t> escaping;  // per cloth vertex
+  bool clean_end = false;              // the last substep provably ended crossing-free ...
+  std::vector<Vec3> expected_x0;       // ... at these positions
   long long excluded = 0;
   // 1, or 0 in the late zone rounds: there only actual contact (the conservative kernels at zero
   // separation) still counts, so a zone that keeps every pair apart but cannot restore the margin
@@ -374,6 +384,41 @@ struct ContactHandler::Impl {
     if (has_body(ctx)) crossing_body = crossing->body_pairs(x0, b0);
   }
 
+  [[nodiscard]] bool touches_escaping(const Face& f) const {
+    return escaping[f[0]] || escaping[f[1]] || escaping[f[2]];
+  }
+
+  // The body's faces are wound counter-clockwise seen from outside (the mannequin's signed
+  // volume is positive), so a cloth vertex of a face crossing body face g that lies behind g's
+  // plane is inside the body. Each such vertex escapes along the outward normal of the deepest
+  // face it is behind, to the repulsion distance in front of it.
+  void find_escapes() {
+    escapes.clear();
+    escaping.assign(x0.size(), 0);
+    if (crossing_body.empty() || !(opt.untangle_step > 0)) return;
+    const auto& cf = model.topology().faces();
+    const auto& bf = body_topo->faces();
+    std::vector<int> slot(x0.size(), -1);
+    for (const auto& [f, g] : crossing_body) {
+      const Face& t = bf[g];
+      Vec3 n = (b0[t[1]] - b0[t[0]]).cross(b0[t[2]] - b0[t[0]]);
+      if (!normalize(n)) continue;
+      for (int i : cf[f]) {
+        const double depth = n.dot(x0[i] - b0[t[0]]);
+        if (!(depth < 0.0) || inv_mass[i] == 0.0) continue;
+        const double push = opt.thickness - depth;
+        if (slot[i] < 0) {
+          slot[i] = static_cast<int>(escapes.size());
+          escapes.push_back({i, g, n, push});
+        } else if (push > escapes[slot[i]].push) {
+          escapes[slot[i]] = {i, g, n, push};
+        }
+      }
+    }
+    for (const Escape& e : escapes)
+      escaping[e.vertex] = 1;
+  }
+
   void ensure_body(const SubstepContext& ctx) {
     if (body_topo) return;
     const int nb = static_cast<int>(ctx.body_t0.size());
@@ -398,6 +443,7 @@ struct ContactHandler::Impl {
     body_swept = false;
     if (has_body(ctx)) ensure_body(ctx);  // the crossing counter and the body queries need it
     find_crossings(ctx);
+    find_escapes();
     const std::span<const Vec3> none;
     const double dh = opt.thickness;
     if (opt.self) {
@@ -447,27 +493,29 @@ struct ContactHandler::Impl {
         }
       };
       tbb::enumerable_thread_specific<BodyPairs> locals;
-      detail::for_each_overlap_parallel(cloth_bvh, body_bvh, locals,
-                                        [&](int f, int g, BodyPairs& out) {
-                                          Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
-                                          box(x0, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
-                                          box(b0, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
-                                          for (int v : cf[f]) {
-                                            if (near(x0[v], x0[v], glo, ghi))
-                                              out.vf_cb.emplace_back(v, g);
-                                          }
-                                          for (int u : bf[g]) {
-                                            if (near(b0[u], b0[u], flo, fhi))
-                                              out.vf_bc.emplace_back(u, f);
-                                          }
-                                          for (int a : model.topology().face_edges(f)) {
-                                            box(x0, {ce[a][0], ce[a][1]}, lo, hi);
-                                            for (int b : body_topo->face_edges(g)) {
-                                              box(b0, {be[b][0], be[b][1]}, lo2, hi2);
-                                              if (near(lo, hi, lo2, hi2)) out.ee.emplace_back(a, b);
-                                            }
-                                          }
-                                        });
+      // An escaping vertex's body pairs would hold it inside (see find_escapes()).
+      auto visit = [&](int f, int g, BodyPairs& out) {
+        Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
+        box(x0, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
+        box(b0, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
+        for (int v : cf[f]) {
+          if (!escaping[v] && near(x0[v], x0[v], glo, ghi)) out.vf_cb.emplace_back(v, g);
+        }
+        if (!touches_escaping(cf[f])) {
+          for (int u : bf[g]) {
+            if (near(b0[u], b0[u], flo, fhi)) out.vf_bc.emplace_back(u, f);
+          }
+        }
+        for (int a : model.topology().face_edges(f)) {
+          if (escaping[ce[a][0]] || escaping[ce[a][1]]) continue;
+          box(x0, {ce[a][0], ce[a][1]}, lo, hi);
+          for (int b : body_topo->face_edges(g)) {
+            box(b0, {be[b][0], be[b][1]}, lo2, hi2);
+            if (near(lo, hi, lo2, hi2)) out.ee.emplace_back(a, b);
+          }
+        }
+      };
+      detail::for_each_overlap_parallel(cloth_bvh, body_bvh, locals, visit);
       const BodyPairs pairs = merge(locals);
       const auto& vf_cb = pairs.vf_cb;
       const auto& vf_bc = pairs.vf_bc;
@@ -656,20 +704,22 @@ struct ContactHandler::Impl {
     };
     const std::span<const Vec3> x1s = x1;
     auto visit = [&](int f, int g, BodyPairs& out) {
+      const bool escape_face = touches_escaping(cf[f]);  // see find_escapes()
       Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
       swept(x0, x1s, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
       swept(b0, b1, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
       for (int i : cf[f]) {
-        if (!vertex_flag[i]) continue;
+        if (!vertex_flag[i] || escaping[i]) continue;
         swept(x0, x1s, {i}, lo, hi);
         if (near(lo, hi, glo, ghi)) out.vf_cb.emplace_back(i, g);
       }
       for (int u : bf[g]) {
+        if (escape_face) break;
         swept(b0, b1, {u}, lo, hi);
         if (near(lo, hi, flo, fhi)) out.vf_bc.emplace_back(u, f);
       }
       for (int a : model.topology().face_edges(f)) {
-        if (!edge_flag[a]) continue;
+        if (!edge_flag[a] || escaping[ce[a][0]] || escaping[ce[a][1]]) continue;
         swept(x0, x1s, {ce[a][0], ce[a][1]}, lo, hi);
         for (int b : body_topo->face_edges(g)) {
           swept(b0, b1, {be[b][0], be[b][1]}, lo2, hi2);
@@ -791,6 +841,19 @@ struct ContactHandler::Impl {
     }
   }
 
+  // Escaping vertices (find_escapes()) move out of the body, relative to the face they are
+  // behind, at up to `untangle_step` per substep. Their body pairs are left out of repulsion and
+  // CCD this substep; self CCD still guards their motion against the rest of the cloth.
+  void untangle(std::span<Vec3> v) const {
+    for (const Escape& e : escapes) {
+      const Face& t = body_topo->faces()[e.body_face];
+      const Vec3 vg = (vb[t[0]] + vb[t[1]] + vb[t[2]]) / 3.0;
+      const double target = std::min(e.push, opt.untangle_step) / h;
+      const double vn = e.n.dot(v[e.vertex] - vg);
+      if (vn < target) v[e.vertex] += (target - vn) * e.n;
+    }
+  }
+
   // The ids whose flag is set.
   static std::vector<int> flagged(const std::vector<std::uint8_t>& flag) {
     std::vector<int> ids;
@@ -834,6 +897,7 @@ struct ContactHandler::Impl {
       }
       if (!any) break;
     }
+    untangle(v);
     // 2. CCD passes with inelastic impulses; later passes test only faces whose vertices moved.
     std::vector<std::uint8_t> touched(n, 0);
     std::vector<int> active;

@@ -265,6 +265,7 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                              {"zone_rounds", c.zone_rounds},
                              {"repulsion_fraction", c.repulsion_fraction},
                              {"repulsion_sweeps", c.repulsion_sweeps},
+                             {"untangle_step", c.untangle_step},
                              {"friction", c.friction}};
     }
     if (scene.count_intersections) {

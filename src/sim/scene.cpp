@@ -427,6 +427,7 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     c.repulsion_fraction = o.number("repulsion_fraction", c.repulsion_fraction, 0.0, 1.0);
     c.repulsion_sweeps = o.integer("repulsion_sweeps", c.repulsion_sweeps, 1, 1000);
     c.full_passes = boolean("full_passes", c.full_passes);
+    c.untangle_step = o.number("untangle_step", c.untangle_step, 0.0, 1.0);
     s.count_intersections = boolean("count_intersections", s.count_intersections);
     o.finish();
   }

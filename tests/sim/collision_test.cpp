@@ -170,6 +170,53 @@ TEST(ContactHandler, PairsAlreadyCrossingAreLeftOutNotFought) {
   EXPECT_LE(count.self_pairs(s.x1).size(), 1u);
 }
 
+TEST(ContactHandler, ClothVertexInsideTheBodyEscapes) {
+  // A body triangle facing +y (counter-clockwise seen from above: outside) and a cloth triangle
+  // crossing it: vertex 0 is 3 mm behind it, the other two 5 mm in front.
+  ClothMeshInput in;
+  in.positions = {{0.3, -0.003, 0.3}, {0.6, 0.005, 0.3}, {0.3, 0.005, 0.6}};
+  in.faces = {{0, 2, 1}};
+  const ClothModel m(in, ClothMaterial{});
+  const std::vector<Vec3> body = {{0, 0, 0}, {0, 0, 1}, {1, 0, 0}};
+  const std::vector<Face> body_faces = {{0, 1, 2}};
+  const std::vector<double> inv(3, 1.0 / m.mass()[0]);
+  IntersectionCounter count(m.topology(), {}, body_faces, 3);
+  ASSERT_EQ(count.body_pairs(m.initial_positions(), body).size(), 1u);
+  for (double step : {0.0, 2e-3}) {
+    ContactOptions o;
+    o.untangle_step = step;
+    ContactHandler handler(m, o);
+    std::vector<Vec3> x = m.initial_positions();
+    const double h = 0.005;
+    for (int k = 0; k < 5; ++k) {
+      SubstepContext ctx;
+      ctx.h = h;
+      ctx.x0 = x;
+      ctx.inverse_mass = inv;
+      ctx.cloth = &m.topology();
+      ctx.body_t0 = body;
+      ctx.body_t1 = body;
+      ctx.body_faces = &body_faces;
+      handler.prepare(ctx);
+      std::vector<Vec3> v(3, Vec3::Zero());
+      (void)handler.respond(ctx, v);
+      for (int i = 0; i < 3; ++i)
+        x[i] += h * v[i];
+    }
+    if (step == 0.0) {
+      // Nothing else undoes a crossing: it stays.
+      EXPECT_EQ(count.body_pairs(x, body).size(), 1u);
+    } else {
+      // 4 mm to go (3 mm depth + 1 mm thickness) at 2 mm per substep: out in two substeps, to
+      // about the repulsion distance in front of the face, and no further.
+      EXPECT_TRUE(count.body_pairs(x, body).empty());
+      EXPECT_GT(x[0].y(), 0.0005);
+      EXPECT_LT(x[0].y(), 0.002);
+      EXPECT_NEAR(x[1].y(), 0.005, 1e-9);
+    }
+  }
+}
+
 TEST(ContactHandler, SqueezedStackIsResolvedByTheProjectionAlone) {
   // Three horizontal squares 1 cm apart; the bottom one rises and the top one falls 1.5 cm in
   // the substep, so both outer pairs cross the middle one. Pushing the middle sheet away from
