@@ -15,31 +15,38 @@
 
 namespace clothcd::sim::detail {
 
+/// One step of a two-tree descent from node pair (i, j): nothing when a_mask excludes i or the
+/// boxes miss, leaf(face_a, face_b) for two leaves, else push(child pair) twice, splitting the
+/// larger node.
+template <class Leaf, class Push>
+void descend(const Bvh& a, int i, const Bvh& b, int j, std::span<const std::uint8_t> a_mask,
+             Leaf&& leaf, Push&& push) {
+  if (!a_mask.empty() && !a_mask[i]) return;
+  const BvhNode& x = a.nodes()[i];
+  const BvhNode& y = b.nodes()[j];
+  if (!overlap(x, y)) return;
+  if (x.is_leaf() && y.is_leaf()) {
+    leaf(a.prim_ids()[x.first], b.prim_ids()[y.first]);
+  } else if (y.is_leaf() || (!x.is_leaf() && x.count >= y.count)) {
+    push(x.left, j);
+    push(x.left + 1, j);
+  } else {
+    push(i, y.left);
+    push(i, y.left + 1);
+  }
+}
+
 /// Calls fn(face_a, face_b) for every pair of a leaf below node `i` of `a` and a leaf below node
 /// `j` of `b` whose boxes overlap; with `a_mask` (one flag per node of `a`), only below nodes of
 /// `a` whose flag is set.
 template <class Fn>
 void for_each_overlap_below(const Bvh& a, int i0, const Bvh& b, int j0, Fn&& fn,
                             std::span<const std::uint8_t> a_mask = {}) {
-  const auto& na = a.nodes();
-  const auto& nb = b.nodes();
   std::vector<std::pair<int, int>> stack{{i0, j0}};
   while (!stack.empty()) {
     const auto [i, j] = stack.back();
     stack.pop_back();
-    const BvhNode& x = na[i];
-    const BvhNode& y = nb[j];
-    if (!a_mask.empty() && !a_mask[i]) continue;
-    if (!overlap(x, y)) continue;
-    if (x.is_leaf() && y.is_leaf()) {
-      fn(a.prim_ids()[x.first], b.prim_ids()[y.first]);
-    } else if (y.is_leaf() || (!x.is_leaf() && x.count >= y.count)) {
-      stack.emplace_back(x.left, j);
-      stack.emplace_back(x.left + 1, j);
-    } else {
-      stack.emplace_back(i, y.left);
-      stack.emplace_back(i, y.left + 1);
-    }
+    descend(a, i, b, j, a_mask, fn, [&](int p, int q) { stack.emplace_back(p, q); });
   }
 }
 
@@ -58,9 +65,7 @@ template <class Local, class Fn>
 void for_each_overlap_parallel(const Bvh& a, const Bvh& b,
                                tbb::enumerable_thread_specific<Local>& locals, Fn&& fn,
                                std::span<const std::uint8_t> a_mask = {}) {
-  const auto& na = a.nodes();
-  const auto& nb = b.nodes();
-  if (na.empty() || nb.empty()) return;
+  if (a.nodes().empty() || b.nodes().empty()) return;
   // Breadth-first to a frontier of node pairs, then each pair's subtrees as one task.
   constexpr std::size_t kTasks = 256;
   std::vector<std::pair<int, int>> frontier{{0, 0}}, next;
@@ -68,19 +73,9 @@ void for_each_overlap_parallel(const Bvh& a, const Bvh& b,
   while (!frontier.empty() && frontier.size() < kTasks) {
     next.clear();
     for (const auto [i, j] : frontier) {
-      if (!a_mask.empty() && !a_mask[i]) continue;
-      const BvhNode& x = na[i];
-      const BvhNode& y = nb[j];
-      if (!overlap(x, y)) continue;
-      if (x.is_leaf() && y.is_leaf()) {
-        fn(a.prim_ids()[x.first], b.prim_ids()[y.first], serial);
-      } else if (y.is_leaf() || (!x.is_leaf() && x.count >= y.count)) {
-        next.emplace_back(x.left, j);
-        next.emplace_back(x.left + 1, j);
-      } else {
-        next.emplace_back(i, y.left);
-        next.emplace_back(i, y.left + 1);
-      }
+      descend(
+          a, i, b, j, a_mask, [&](int f, int g) { fn(f, g, serial); },
+          [&](int p, int q) { next.emplace_back(p, q); });
     }
     frontier.swap(next);
   }

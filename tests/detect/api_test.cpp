@@ -73,6 +73,33 @@ TEST(DetectApi, ProximityEqualsAllPairsDistance) {
   }
 }
 
+// A detector restricted by `restrict` finds `ref`, a strict non-empty part of `full`, and
+// `full` again once the restriction is cleared; both builds, with and without culling.
+template <class Restrict>
+void check_restricted(const ProceduralScene& s, const DetectResult& full, const DetectResult& ref,
+                      Restrict&& restrict) {
+  EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u) << s.name;
+  EXPECT_LT(ref.vf.size() + ref.ee.size(), full.vf.size() + full.ee.size()) << s.name;
+  for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+    for (Culling culling : {Culling::None, Culling::Sound}) {
+      SCOPED_TRACE(::testing::Message()
+                   << s.name << " build " << int(build) << " culling " << int(culling));
+      DetectOptions o;
+      o.build = build;
+      o.culling = culling;
+      SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+      restrict(det);
+      const DetectResult r = det.detect(s.v_t0, s.v_t1);
+      EXPECT_EQ(r.vf, ref.vf);
+      EXPECT_EQ(r.ee, ref.ee);
+      det.clear_active_faces();
+      const DetectResult all = det.detect(s.v_t0, s.v_t1);
+      EXPECT_EQ(all.vf, full.vf);
+      EXPECT_EQ(all.ee, full.ee);
+    }
+  }
+}
+
 TEST(DetectApi, ActiveFacesEqualFilteredBruteForce) {
   for (const auto& s : {crumpled_sheet(8, 3), twisted_strip(30, 3)}) {
     const Topology topo(s.faces, s.num_vertices);
@@ -87,26 +114,7 @@ TEST(DetectApi, ActiveFacesEqualFilteredBruteForce) {
     }
     const DetectResult full = brute_force_detect(topo, s.v_t0, s.v_t1);
     const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1, {}, mask);
-    EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u) << s.name;
-    EXPECT_LT(ref.vf.size() + ref.ee.size(), full.vf.size() + full.ee.size()) << s.name;
-    for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
-      for (Culling culling : {Culling::None, Culling::Sound}) {
-        SCOPED_TRACE(::testing::Message()
-                     << s.name << " build " << int(build) << " culling " << int(culling));
-        DetectOptions o;
-        o.build = build;
-        o.culling = culling;
-        SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
-        det.set_active_faces(active);
-        const DetectResult r = det.detect(s.v_t0, s.v_t1);
-        EXPECT_EQ(r.vf, ref.vf);
-        EXPECT_EQ(r.ee, ref.ee);
-        det.clear_active_faces();
-        const DetectResult all = det.detect(s.v_t0, s.v_t1);
-        EXPECT_EQ(all.vf, full.vf);
-        EXPECT_EQ(all.ee, full.ee);
-      }
-    }
+    check_restricted(s, full, ref, [&](SelfDetector& d) { d.set_active_faces(active); });
   }
 }
 
@@ -133,26 +141,7 @@ TEST(DetectApi, ActiveVerticesEqualFilteredBruteForce) {
       const Edge &a = c.edge_a_vertices, &b = c.edge_b_vertices;
       if (on[a[0]] || on[a[1]] || on[b[0]] || on[b[1]]) ref.ee.push_back(c);
     }
-    EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u) << s.name;
-    EXPECT_LT(ref.vf.size() + ref.ee.size(), full.vf.size() + full.ee.size()) << s.name;
-    for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
-      for (Culling culling : {Culling::None, Culling::Sound}) {
-        SCOPED_TRACE(::testing::Message()
-                     << s.name << " build " << int(build) << " culling " << int(culling));
-        DetectOptions o;
-        o.build = build;
-        o.culling = culling;
-        SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
-        det.set_active_vertices(active);
-        const DetectResult r = det.detect(s.v_t0, s.v_t1);
-        EXPECT_EQ(r.vf, ref.vf);
-        EXPECT_EQ(r.ee, ref.ee);
-        det.clear_active_faces();
-        const DetectResult all = det.detect(s.v_t0, s.v_t1);
-        EXPECT_EQ(all.vf, full.vf);
-        EXPECT_EQ(all.ee, full.ee);
-      }
-    }
+    check_restricted(s, full, ref, [&](SelfDetector& d) { d.set_active_vertices(active); });
     SelfDetector det(s.faces, s.num_vertices, s.v_t0, {});
     const std::vector<int> bad{0, s.num_vertices};
     EXPECT_THROW(det.set_active_vertices(bad), InputError);
