@@ -26,6 +26,16 @@ int Bvh::num_disk_internal() const {
                                         [](const BvhNode& n) { return !n.is_leaf() && n.disk(); }));
 }
 
+std::vector<std::uint8_t> Bvh::nodes_holding(std::span<const std::uint8_t> face_flags) const {
+  std::vector<std::uint8_t> out(nodes_.size(), 0);
+  // Children come after their parent, so a backward sweep sees both before the parent.
+  for (int i = static_cast<int>(nodes_.size()) - 1; i >= 0; --i) {
+    const BvhNode& n = nodes_[i];
+    out[i] = n.is_leaf() ? face_flags[prim_ids_[n.first]] : (out[n.left] | out[n.left + 1]);
+  }
+  return out;
+}
+
 void Bvh::compute_flags() {
   const Topology& topo = *topology_;
   const int nn = static_cast<int>(nodes_.size());

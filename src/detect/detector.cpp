@@ -138,7 +138,6 @@ struct SelfDetector::Impl {
     ctx.np_filter = opt.np_filter;
     ctx.ccd = CcdOptions{opt.thickness, opt.fast_path};
     ctx.ccd.toi_tolerance = opt.toi_tolerance;
-    ctx.ccd.tolerance = opt.ccd_tolerance;
     ctx.distance_depth = opt.distance_filter_depth;
     ctx.links = links;
     detail::precompute_boxes(ctx, vboxes, eboxes, fboxes);
@@ -372,15 +371,9 @@ struct SelfDetector::Impl {
     set_nodes(face_active);
   }
 
-  // Nodes holding a face that can represent an in-scope pair (children follow their parent).
+  // Nodes holding a face that can represent an in-scope pair.
   void set_nodes(const std::vector<std::uint8_t>& touch) {
-    const auto& nodes = bvh.nodes();
-    node_active.assign(nodes.size(), 0);
-    for (int i = static_cast<int>(nodes.size()) - 1; i >= 0; --i) {
-      const BvhNode& n = nodes[i];
-      node_active[i] = n.is_leaf() ? touch[bvh.prim_ids()[n.first]]
-                                   : (node_active[n.left] | node_active[n.left + 1]);
-    }
+    node_active = bvh.nodes_holding(touch);
     restricted = true;
   }
 };

@@ -30,7 +30,6 @@ detail::FeatureContext make_context(const Topology& topo, const std::vector<Eige
   ctx.np_filter = o.np_filter;
   ctx.ccd = CcdOptions{o.thickness, o.fast_path};
   ctx.ccd.toi_tolerance = o.toi_tolerance;
-  ctx.ccd.tolerance = o.ccd_tolerance;
   ctx.distance_depth = o.distance_filter_depth;
   return ctx;
 }

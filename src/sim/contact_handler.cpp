@@ -703,8 +703,8 @@ struct ContactHandler::Impl {
              (lo_b.array() <= hi_a.array() + sep).all();
     };
     const std::span<const Vec3> x1s = x1;
+    // An escaping vertex's body pairs would hold it inside (see find_escapes()).
     auto visit = [&](int f, int g, BodyPairs& out) {
-      const bool escape_face = touches_escaping(cf[f]);  // see find_escapes()
       Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
       swept(x0, x1s, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
       swept(b0, b1, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
@@ -713,10 +713,11 @@ struct ContactHandler::Impl {
         swept(x0, x1s, {i}, lo, hi);
         if (near(lo, hi, glo, ghi)) out.vf_cb.emplace_back(i, g);
       }
-      for (int u : bf[g]) {
-        if (escape_face) break;
-        swept(b0, b1, {u}, lo, hi);
-        if (near(lo, hi, flo, fhi)) out.vf_bc.emplace_back(u, f);
+      if (!touches_escaping(cf[f])) {
+        for (int u : bf[g]) {
+          swept(b0, b1, {u}, lo, hi);
+          if (near(lo, hi, flo, fhi)) out.vf_bc.emplace_back(u, f);
+        }
       }
       for (int a : model.topology().face_edges(f)) {
         if (!edge_flag[a] || escaping[ce[a][0]] || escaping[ce[a][1]]) continue;
@@ -832,13 +833,7 @@ struct ContactHandler::Impl {
     }
     for (int e = 0; e < t.num_edges(); ++e)
       edge_flag[e] = vertex_flag[t.edges()[e][0]] | vertex_flag[t.edges()[e][1]];
-    const auto& nodes = cloth_bvh.nodes();
-    node_flag.assign(nodes.size(), 0);
-    for (int k = static_cast<int>(nodes.size()) - 1; k >= 0; --k) {
-      const BvhNode& nd = nodes[k];
-      node_flag[k] = nd.is_leaf() ? face_flag[cloth_bvh.prim_ids()[nd.first]]
-                                  : (node_flag[nd.left] | node_flag[nd.left + 1]);
-    }
+    node_flag = cloth_bvh.nodes_holding(face_flag);
   }
 
   // Escaping vertices (find_escapes()) move out of the body, relative to the face they are
@@ -871,29 +866,24 @@ struct ContactHandler::Impl {
       for (std::size_t i = 0; i < b0.size(); ++i)
         vb[i] = (b1[i] - b0[i]) / h;
     }
-    // 1. Repulsion and friction (sorted pairs, Gauss-Seidel; friction in the first sweep).
+    // 1. Repulsion and friction (sorted pairs, Gauss-Seidel), sweeping until no pair approaches
+    // faster than its target (one sweep left coupled pairs approaching, and each became a CCD
+    // hit, a constraint and a vertex of every later pass's scope); friction in the first sweep.
     st.proximity_pairs = static_cast<long long>(proximity.size());
-    for (const Contact& c : proximity) {
-      const double target = opt.repulsion_fraction * (opt.thickness - c.gap) / h;
-      const Vec3 rel = relative_velocity(c, v);
-      const double vn = c.n.dot(rel);
-      if (vn >= target) continue;
-      const double dn = target - vn;
-      if (!impulse(c, c.n, dn, v)) continue;
-      Vec3 vt = rel - vn * c.n;
-      const double lt = vt.norm();
-      if (opt.friction > 0 && lt > 0) impulse(c, -vt / lt, std::min(opt.friction * dn, lt), v);
-    }
-    // Further sweeps (normal impulses only) until no pair approaches faster than its target:
-    // one sweep leaves coupled pairs approaching, and each becomes a CCD hit, a constraint and a
-    // vertex of every later pass's scope.
-    for (int sweep = 1; sweep < opt.repulsion_sweeps; ++sweep) {
+    for (int sweep = 0; sweep < opt.repulsion_sweeps; ++sweep) {
       bool any = false;
       for (const Contact& c : proximity) {
         const double target = opt.repulsion_fraction * (opt.thickness - c.gap) / h;
-        const double vn = c.n.dot(relative_velocity(c, v));
+        const Vec3 rel = relative_velocity(c, v);
+        const double vn = c.n.dot(rel);
         if (vn >= target) continue;
-        any |= impulse(c, c.n, target - vn, v);
+        const double dn = target - vn;
+        if (!impulse(c, c.n, dn, v)) continue;
+        any = true;
+        if (sweep > 0 || !(opt.friction > 0)) continue;
+        const Vec3 vt = rel - vn * c.n;
+        const double lt = vt.norm();
+        if (lt > 0) impulse(c, -vt / lt, std::min(opt.friction * dn, lt), v);
       }
       if (!any) break;
     }

@@ -87,6 +87,9 @@ class Bvh {
   [[nodiscard]] int num_internal() const;
   [[nodiscard]] int num_connected_internal() const;
   [[nodiscard]] int num_disk_internal() const;
+  /// One flag per node: set when a face below it is flagged in `face_flags` (one per face).
+  [[nodiscard]] std::vector<std::uint8_t> nodes_holding(
+      std::span<const std::uint8_t> face_flags) const;
 
   /// Swept boxes of every triangle over the linear motion t0 -> t1 and, optionally, CCD cones.
   void refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,

@@ -33,11 +33,6 @@ struct DetectOptions {
   /// CcdOptions::toi_tolerance of the kernels: how closely a hit's time of impact is refined
   /// (always on the early side). A simulator's response rarely needs more than a few percent.
   double toi_tolerance = 1e-4;
-  /// CcdOptions::tolerance of the kernels: the size (relative to a query's extent) at which the
-  /// solver stops splitting and reports a hit. A hit certifies a distance within
-  /// sqrt(3) (thickness + tolerance x extent), so a simulator with a contact thickness can
-  /// raise it towards thickness / extent and save most of the splitting.
-  double ccd_tolerance = 1e-6;
   /// Bisections of the distance filter (`distance_filter_culls` depth) when thickness > 0: each
   /// level can cull near misses the whole-step bound cannot, before the costlier kernel runs.
   int distance_filter_depth = 0;
