@@ -72,7 +72,7 @@ void for_each_overlap_parallel(const Bvh& a, const Bvh& b,
   Local& serial = locals.local();
   while (!frontier.empty() && frontier.size() < kTasks) {
     next.clear();
-    for (const auto [i, j] : frontier) {
+    for (const auto& [i, j] : frontier) {
       descend(
           a, i, b, j, a_mask, [&](int f, int g) { fn(f, g, serial); },
           [&](int p, int q) { next.emplace_back(p, q); });

@@ -65,7 +65,10 @@ TEST(DetectApi, DeeperDistanceFilterDropsOnlyPairsThatStayApart) {
   const std::pair<ProceduralScene, double> cases[] = {
       {crumpled_sheet(7, 4), 0.001}, {crumpled_sheet(7, 4), 0.01}, {winding_strip(36, 2), 0.001}};
   std::size_t dropped = 0;
-  for (const auto& [s, thickness] : cases) {
+  for (const auto& entry : cases) {
+    // Named, not structured bindings: the lambdas below capture them (clang 14 cannot).
+    const ProceduralScene& s = entry.first;
+    const double thickness = entry.second;
     SCOPED_TRACE(::testing::Message() << s.name << " thickness " << thickness);
     const Topology topo(s.faces, s.num_vertices);
     DetectOptions o;
