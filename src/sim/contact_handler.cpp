@@ -2,7 +2,6 @@
 // rigid impact zones.
 #include "clothcd/sim/contact_handler.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,6 +20,7 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/sim/intersections.hpp"
 #include "seam_links.hpp"
+#include "zone_motion.hpp"
 
 namespace clothcd::sim {
 namespace {
@@ -56,44 +56,6 @@ bool normalize(Vec3& n) {
   if (!(l > 1e-14)) return false;
   n /= l;
   return true;
-}
-
-// v(x) = v_c + omega x (x - x_c).
-struct RigidMotion {
-  Vec3 xc = Vec3::Zero(), vc = Vec3::Zero(), omega = Vec3::Zero();
-  [[nodiscard]] Vec3 at(const Vec3& x) const { return vc + omega.cross(x - xc); }
-};
-
-// The rigid motion nearest the given point velocities in the weighted least-squares sense: the
-// weighted mean velocity about the weighted centroid, and the angular velocity from the
-// points' angular momentum and inertia (pseudo-inverse: collinear points fix no spin about
-// their line).
-RigidMotion fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
-                      const std::vector<double>& w) {
-  RigidMotion r;
-  double wt = 0.0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    wt += w[i];
-    r.xc += w[i] * x[i];
-    r.vc += w[i] * v[i];
-  }
-  if (!(wt > 0.0)) return r;
-  r.xc /= wt;
-  r.vc /= wt;
-  Vec3 l = Vec3::Zero();
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    const Vec3 d = x[i] - r.xc;
-    l += w[i] * d.cross(v[i] - r.vc);
-    inertia += w[i] * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(inertia);
-  const Vec3 ev = es.eigenvalues();
-  Vec3 a = es.eigenvectors().transpose() * l;
-  for (int k = 0; k < 3; ++k)
-    a[k] = ev[k] > 1e-12 * std::max(ev[2], 1e-300) ? a[k] / ev[k] : 0.0;
-  r.omega = es.eigenvectors() * a;
-  return r;
 }
 
 class UnionFind {

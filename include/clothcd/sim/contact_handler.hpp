@@ -36,9 +36,10 @@ struct ContactOptions {
   /// both give bitwise the same result (tested).
   bool full_passes = false;
   /// Cloth vertices found inside the body (behind a body face that one of their faces crosses)
-  /// move out along that face's normal by up to this much per substep (m; 0: off, the default:
-  /// on multilayer-kick frames 72-73, caught between the kicking legs, 2 mm gave 803 and 813
-  /// body crossings where the run without it had 619 at frame 72).
+  /// move out along that face's normal by up to this much per substep (m; 0: off, the default).
+  /// 2 mm from frame 0 undid the body crossings of dress-kick and of multilayer-kick's frames
+  /// 51-53, but resumed inside multilayer-kick's deep tangle of frame 72 it gave 803 and 813
+  /// crossings where the run without it had 619.
   double untangle_step = 0.0;
   double friction = 0.2;  ///< Coulomb coefficient of the contact impulses
 };

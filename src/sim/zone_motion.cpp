@@ -1,0 +1,37 @@
+#include "zone_motion.hpp"
+
+#include <algorithm>
+
+#include <Eigen/Eigenvalues>
+
+namespace clothcd::sim {
+
+RigidMotion fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                      const std::vector<double>& w) {
+  RigidMotion r;
+  double wt = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    wt += w[i];
+    r.xc += w[i] * x[i];
+    r.vc += w[i] * v[i];
+  }
+  if (!(wt > 0.0)) return r;
+  r.xc /= wt;
+  r.vc /= wt;
+  Vec3 l = Vec3::Zero();
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Vec3 d = x[i] - r.xc;
+    l += w[i] * d.cross(v[i] - r.vc);
+    inertia += w[i] * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(inertia);
+  const Vec3 ev = es.eigenvalues();
+  Vec3 a = es.eigenvectors().transpose() * l;
+  for (int k = 0; k < 3; ++k)
+    a[k] = ev[k] > 1e-12 * std::max(ev[2], 1e-300) ? a[k] / ev[k] : 0.0;
+  r.omega = es.eigenvectors() * a;
+  return r;
+}
+
+}  // namespace clothcd::sim
