@@ -360,14 +360,8 @@ struct SelfDetector::Impl {
       }
       vertex_active[v] = 1;
     }
-    face_active.assign(topo.num_faces(), 0);
-    for (int f = 0; f < topo.num_faces(); ++f) {
-      for (int v : topo.faces()[f])
-        face_active[f] |= vertex_active[v];
-    }
-    edge_active.assign(topo.num_edges(), 0);
-    for (int e = 0; e < topo.num_edges(); ++e)
-      edge_active[e] = vertex_active[topo.edges()[e][0]] | vertex_active[topo.edges()[e][1]];
+    face_active = topo.faces_touching(vertex_active);
+    edge_active = topo.edges_touching(vertex_active);
     set_nodes(face_active);
   }
 

@@ -217,4 +217,22 @@ std::vector<int> Topology::face_neighbors(int f) const {
   return out;
 }
 
+std::vector<std::uint8_t> Topology::faces_touching(
+    std::span<const std::uint8_t> vertex_flags) const {
+  std::vector<std::uint8_t> out(faces_.size(), 0);
+  for (std::size_t f = 0; f < faces_.size(); ++f) {
+    for (int v : faces_[f])
+      out[f] |= vertex_flags[v];
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> Topology::edges_touching(
+    std::span<const std::uint8_t> vertex_flags) const {
+  std::vector<std::uint8_t> out(edges_.size(), 0);
+  for (std::size_t e = 0; e < edges_.size(); ++e)
+    out[e] = vertex_flags[edges_[e][0]] | vertex_flags[edges_[e][1]];
+  return out;
+}
+
 }  // namespace clothcd

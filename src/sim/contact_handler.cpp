@@ -782,19 +782,17 @@ struct ContactHandler::Impl {
   // Scope flags of a restricted pass (all set when `active` is null).
   void set_flags(const std::vector<int>* active) {
     const Topology& t = model.topology();
-    const std::uint8_t all = active == nullptr ? 1 : 0;
-    vertex_flag.assign(t.num_vertices(), all);
-    face_flag.assign(t.num_faces(), all);
-    edge_flag.assign(t.num_edges(), all);
-    if (active == nullptr) return;
+    if (active == nullptr) {
+      vertex_flag.assign(t.num_vertices(), 1);
+      face_flag.assign(t.num_faces(), 1);
+      edge_flag.assign(t.num_edges(), 1);
+      return;
+    }
+    vertex_flag.assign(t.num_vertices(), 0);
     for (int i : *active)
       vertex_flag[i] = 1;
-    for (int f = 0; f < t.num_faces(); ++f) {
-      for (int i : t.faces()[f])
-        face_flag[f] |= vertex_flag[i];
-    }
-    for (int e = 0; e < t.num_edges(); ++e)
-      edge_flag[e] = vertex_flag[t.edges()[e][0]] | vertex_flag[t.edges()[e][1]];
+    face_flag = t.faces_touching(vertex_flag);
+    edge_flag = t.edges_touching(vertex_flag);
     node_flag = cloth_bvh.nodes_holding(face_flag);
   }
 
@@ -1049,7 +1047,7 @@ struct ContactHandler::Impl {
             weights.push_back(1.0);
           }
         }
-        const RigidMotion rm = fit_rigid(points, velocities, weights);
+        const detail::RigidMotion rm = detail::fit_rigid(points, velocities, weights);
         for (int i : m) {
           if (inv_mass[i] != 0.0) v[i] = rm.at(x0[i]);
         }

@@ -27,7 +27,7 @@ std::vector<Stitch> recover_stitches(const std::vector<Vec3>& x, const std::vect
   }
   // Hash the edges' boxes into cells of size >= max_distance.
   const double cell = std::max(max_distance, 1e-6) * 4.0;
-  auto key = [cell](long i, long j, long k) {
+  auto key = [](long i, long j, long k) {
     return (i * 73856093L) ^ (j * 19349663L) ^ (k * 83492791L);
   };
   auto coord = [cell](double v) { return static_cast<long>(std::floor(v / cell)); };

@@ -4,7 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 
-namespace clothcd::sim {
+namespace clothcd::sim::detail {
 
 RigidMotion fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
                       const std::vector<double>& w) {
@@ -34,4 +34,4 @@ RigidMotion fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
   return r;
 }
 
-}  // namespace clothcd::sim
+}  // namespace clothcd::sim::detail

@@ -6,7 +6,7 @@
 
 #include "clothcd/sim/cloth_model.hpp"
 
-namespace clothcd::sim {
+namespace clothcd::sim::detail {
 
 /// v(x) = v_c + omega x (x - x_c). Applied as x + t v(x) over a substep, the zone's map is
 /// linear with determinant 1 + t^2 |omega|^2 > 0, so nothing inside the zone can collide.
@@ -22,4 +22,4 @@ struct RigidMotion {
 [[nodiscard]] RigidMotion fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
                                     const std::vector<double>& w);
 
-}  // namespace clothcd::sim
+}  // namespace clothcd::sim::detail

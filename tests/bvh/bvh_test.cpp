@@ -54,7 +54,9 @@ TEST(Bvh, StructureAndFlagsMatchBruteForce) {
         std::vector<int> faces(bvh.prim_ids().begin() + n.first,
                                bvh.prim_ids().begin() + n.first + n.count);
         EXPECT_EQ(n.connected(), connected_brute(topo, faces)) << "node " << i;
-        if (n.disk()) EXPECT_TRUE(n.connected());
+        if (n.disk()) {
+          EXPECT_TRUE(n.connected());
+        }
         for (int f : faces) {
           for (int c : topo.faces()[f]) {
             for (int k = 0; k < 3; ++k) {
@@ -73,8 +75,12 @@ TEST(Bvh, StructureAndFlagsMatchBruteForce) {
         }
       }
       // The whole of a connected single sheet is a disk in either build.
-      if (s.name == "crumpled_sheet") EXPECT_TRUE(nodes[0].disk());
-      if (s.name == "stacked_sheets") EXPECT_FALSE(nodes[0].connected());
+      if (s.name == "crumpled_sheet") {
+        EXPECT_TRUE(nodes[0].disk());
+      }
+      if (s.name == "stacked_sheets") {
+        EXPECT_FALSE(nodes[0].connected());
+      }
       if (build == BvhBuild::Patch && topo.num_components() == 1) {
         EXPECT_EQ(bvh.num_connected_internal(), bvh.num_internal());
       }

@@ -115,7 +115,9 @@ TEST(CcdCertified, CertifiedHitsAreRealAndEarly) {
         const auto where = ::testing::Message()
                            << "seed " << seed << " #" << i << (vf ? " VF" : " EE") << " toi_tol "
                            << toi_tol << " toi " << r.toi;
-        if (truth) ASSERT_TRUE(r.hit) << "false negative: " << where;
+        if (truth) {
+          ASSERT_TRUE(r.hit) << "false negative: " << where;
+        }
         if (r.hit && r.toi > 0) {
           ASSERT_FALSE(exact(p, vf, std::nextafter(r.toi, 0.0))) << "contact before toi: " << where;
         }

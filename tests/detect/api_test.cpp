@@ -56,7 +56,9 @@ TEST(DetectApi, ProximityEqualsAllPairsDistance) {
     const Positions v = 0.5 * (s.v_t0 + s.v_t1);
     for (double h : {0.0, 0.01, 0.05}) {
       const ProximityResult ref = brute_force_proximity(topo, v, h);
-      if (h > 0) EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u);
+      if (h > 0) {
+        EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u);
+      }
       for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
         SCOPED_TRACE(::testing::Message() << s.name << " h " << h << " build " << int(build));
         DetectOptions o;

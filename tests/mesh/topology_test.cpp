@@ -140,6 +140,19 @@ void check_against_brute_force(const std::vector<Face>& faces, int nv) {
     EXPECT_EQ(topo.face_component(f), numbering[r]) << "face " << f;
   }
   EXPECT_EQ(topo.num_components(), static_cast<int>(numbering.size()));
+  // Faces and edges touching flagged vertices (every third vertex, then none).
+  for (int every : {3, nv + 1}) {
+    std::vector<std::uint8_t> flag(static_cast<std::size_t>(nv), 0);
+    for (int v = 1; v < nv; v += every)
+      flag[v] = 1;
+    std::vector<std::uint8_t> faces_ref(static_cast<std::size_t>(nf), 0), edges_ref;
+    for (int f = 0; f < nf; ++f)
+      faces_ref[f] = flag[faces[f][0]] || flag[faces[f][1]] || flag[faces[f][2]];
+    for (const Edge& e : topo.edges())
+      edges_ref.push_back(flag[e[0]] || flag[e[1]]);
+    EXPECT_EQ(topo.faces_touching(flag), faces_ref) << "every " << every;
+    EXPECT_EQ(topo.edges_touching(flag), edges_ref) << "every " << every;
+  }
 }
 
 TEST(Topology, SingleTriangle) {

@@ -7,7 +7,7 @@
 
 #include "sim/zone_motion.hpp"
 
-namespace clothcd::sim {
+namespace clothcd::sim::detail {
 namespace {
 
 struct Points {
@@ -86,4 +86,4 @@ TEST(ZoneMotion, CollinearPointsGetNoSpinAboutTheirLine) {
 }
 
 }  // namespace
-}  // namespace clothcd::sim
+}  // namespace clothcd::sim::detail

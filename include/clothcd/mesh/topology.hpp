@@ -50,6 +50,12 @@ class Topology {
   [[nodiscard]] bool faces_share_vertex(int f, int g) const;
   /// Faces other than f sharing an edge with f, ascending and unique.
   [[nodiscard]] std::vector<int> face_neighbors(int f) const;
+  /// One flag per face (edge): set when one of its vertices is flagged in `vertex_flags` (one
+  /// per vertex).
+  [[nodiscard]] std::vector<std::uint8_t> faces_touching(
+      std::span<const std::uint8_t> vertex_flags) const;
+  [[nodiscard]] std::vector<std::uint8_t> edges_touching(
+      std::span<const std::uint8_t> vertex_flags) const;
 
   [[nodiscard]] int num_boundary_edges() const { return num_boundary_edges_; }
   [[nodiscard]] int num_nonmanifold_edges() const { return num_nonmanifold_edges_; }
