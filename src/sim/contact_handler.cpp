@@ -946,11 +946,15 @@ struct ContactHandler::Impl {
     const int n = model.num_vertices();
     UnionFind uf(n);
     std::vector<std::uint8_t> in_zone(n, 0);
-    std::vector<std::pair<int, Vec3>> anchors;  // cloth vertex, velocity it must follow
+    // A cloth vertex, the body point it touches (at t0) and the velocity it must follow there.
+    struct Anchor {
+      int vertex = -1;
+      Vec3 point, velocity;
+    };
+    std::vector<Anchor> anchors;
     // Per substep: 0.1 mm with the scenes' settings (dress-rumba frames 1-12: no body crossing
     // and max stretch 0.96, against 25 crossing pairs and 1.2-3.2 without it).
     const double anchor_push = std::max(2.0 * opt.ccd_thickness, 0.1 * opt.thickness);
-    std::vector<Vec3> vertex_anchor_sum(n, Vec3::Zero());
     std::vector<int> vertex_anchor_count(n, 0);
     std::vector<int> active = flagged(changed);
     const auto& mass = model.mass();
@@ -968,10 +972,11 @@ struct ContactHandler::Impl {
       ++st.zone_rounds;
       for (const Contact& c : hs) {
         int first = -1;
-        Vec3 body_v = Vec3::Zero();
+        Vec3 body_p = Vec3::Zero(), body_v = Vec3::Zero();
         double body_w = 0.0;
         for (int k = 0; k < 4; ++k) {
           if (c.on_body[k]) {
+            body_p += std::abs(c.c[k]) * b0[c.id[k]];
             body_v += std::abs(c.c[k]) * vb[c.id[k]];
             body_w += std::abs(c.c[k]);
             continue;
@@ -990,7 +995,8 @@ struct ContactHandler::Impl {
             // near-zero gap that the body's own deformation then closes.
             if (!c.on_body[k]) {
               const double side = c.c[k] > 0 ? 1.0 : -1.0;
-              anchors.emplace_back(c.id[k], body_v / body_w + side * anchor_push / h * c.n);
+              anchors.push_back(
+                  {c.id[k], body_p / body_w, body_v / body_w + side * anchor_push / h * c.n});
             }
           }
         }
@@ -1009,11 +1015,12 @@ struct ContactHandler::Impl {
         members[zone_of[i]].push_back(i);
       }
       std::vector<int> anchor_count(members.size(), 0);  // > 0: the zone is anchored
-      std::fill(vertex_anchor_sum.begin(), vertex_anchor_sum.end(), Vec3::Zero());
       std::fill(vertex_anchor_count.begin(), vertex_anchor_count.end(), 0);
-      for (const auto& [i, vel] : anchors) {
+      std::vector<std::vector<int>> zone_anchors(members.size());
+      for (std::size_t a = 0; a < anchors.size(); ++a) {
+        const int i = anchors[a].vertex;
         ++anchor_count[zone_of[i]];
-        vertex_anchor_sum[i] += vel;
+        zone_anchors[zone_of[i]].push_back(static_cast<int>(a));
         ++vertex_anchor_count[i];
       }
       std::fill(changed.begin(), changed.end(), 0);
@@ -1028,8 +1035,13 @@ struct ContactHandler::Impl {
         // The zone moves rigidly (an invertible linear map of its start positions over the
         // substep, so nothing inside it can collide): free zones keep their momentum and angular
         // momentum (Provot 1997); zones touching the body or a pin take the rigid motion closest
-        // to their anchors' velocities. Letting each vertex follow its own anchor instead bent
-        // the zone, and on the multilayer the zone rounds then stalled on self hits inside it.
+        // to the body's velocities at the points they touch (and the pins'). Fitted at the cloth
+        // vertices instead, each given its contacts' body velocity, the fit was off wherever a
+        // body point touched a long cloth edge or face: on multilayer-kick frame 69 (stretch 12)
+        // one contact anchored vertices 12 cm apart to one velocity on a turning leg, the fit
+        // missed the anchors by 1.65 mm per substep, and the zones gave up (312 body pairs; 104
+        // with this). Letting each vertex follow its own anchor instead bent the zone, and on the
+        // multilayer the zone rounds then stalled on self hits inside it.
         std::vector<Vec3> points, velocities;
         std::vector<double> weights;
         for (int i : m) {
@@ -1041,11 +1053,13 @@ struct ContactHandler::Impl {
             points.push_back(x0[i]);
             velocities.push_back(v[i]);
             weights.push_back(1.0);
-          } else if (vertex_anchor_count[i] > 0) {
-            points.push_back(x0[i]);
-            velocities.push_back(vertex_anchor_sum[i] / vertex_anchor_count[i]);
-            weights.push_back(1.0);
           }
+        }
+        for (int a : zone_anchors[z]) {
+          const Anchor& an = anchors[static_cast<std::size_t>(a)];
+          points.push_back(an.point);
+          velocities.push_back(an.velocity);
+          weights.push_back(1.0 / vertex_anchor_count[an.vertex]);
         }
         const detail::RigidMotion rm = detail::fit_rigid(points, velocities, weights);
         for (int i : m) {
