@@ -21,6 +21,8 @@ struct SimulateArgs {
   std::string out;
   int frames = -1;
   bool resume = false;
+  int resume_at = -1;
+  int keep_states = 0;
   int threads = 0;
 };
 
@@ -76,6 +78,14 @@ const bool registered = clothcd::app::register_command(
       sub.add_option("--frames", args->frames, "Frames to reach (default: the scene's)")
           ->check(CLI::NonNegativeNumber);
       sub.add_flag("--resume", args->resume, "Continue from the last complete frame in --out");
+      sub.add_option("--resume-at", args->resume_at,
+                     "Continue from this frame's kept state in --out (see --keep-states); the "
+                     "later frames are dropped and simulated again")
+          ->check(CLI::NonNegativeNumber);
+      sub.add_option("--keep-states", args->keep_states,
+                     "Also keep the state of every N-th frame, for --resume-at (default 0: the "
+                     "last frame's only)")
+          ->check(CLI::NonNegativeNumber);
       sub.add_option("--threads", args->threads, "Worker threads (default: all cores)")
           ->check(CLI::PositiveNumber);
       return [args]() {
@@ -103,8 +113,11 @@ const bool registered = clothcd::app::register_command(
         clothcd::sim::RunOptions opt;
         opt.out = args->out;
         opt.frames = args->frames;
-        opt.resume = args->resume;
-        if (args->resume && !std::filesystem::exists(opt.out / "manifest.json")) {
+        opt.resume = args->resume || args->resume_at >= 0;
+        opt.resume_at = args->resume_at;
+        opt.keep_states = args->keep_states;
+        if (args->resume && args->resume_at < 0 &&
+            !std::filesystem::exists(opt.out / "manifest.json")) {
           fmt::print(stderr, "no manifest in {}: starting from frame 0\n", args->out);
         }
         std::unique_ptr<Progress> progress;

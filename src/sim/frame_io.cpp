@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cmath>
@@ -23,6 +24,32 @@ std::string frame_name(int frame, const std::string& ext) {
 }
 std::string state_name(int frame) {
   return fmt::format("state_{:04d}.bin", frame);
+}
+
+// The frame number of `name` when it is `prefix` + digits + `suffix`, else -1.
+int numbered(const std::string& name, const std::string& prefix, const std::string& suffix) {
+  if (name.size() <= prefix.size() + suffix.size() || !name.starts_with(prefix) ||
+      !name.ends_with(suffix))
+    return -1;
+  const std::string digits =
+      name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
+  if (digits.size() > 9 ||
+      !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return -1;
+  return std::stoi(digits);
+}
+
+// Removes the mesh and state files of frames after `frame` (left by a run resumed earlier).
+void remove_frames_after(const std::filesystem::path& dir, int frame, const std::string& ext) {
+  std::vector<std::filesystem::path> stale;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (numbered(name, "state_", ".bin") > frame || numbered(name, "frame_", "." + ext) > frame)
+      stale.push_back(e.path());
+  }
+  std::error_code ec;
+  for (const auto& p : stale)
+    std::filesystem::remove(p, ec);
 }
 
 template <typename T>
@@ -197,6 +224,10 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
   const std::string ext = scene.output_format;
   const auto& faces = sim.model().topology().faces();
   const int n = sim.model().num_vertices();
+  if (opt.resume_at >= 0 && !(opt.resume && fs::exists(opt.out / "manifest.json"))) {
+    throw input_error((opt.out / "manifest.json").string(), 0,
+                      fmt::format("cannot resume at frame {}: no run to resume", opt.resume_at));
+  }
   std::error_code ec;
   fs::create_directories(opt.out, ec);
   if (ec || !fs::is_directory(opt.out)) {
@@ -232,6 +263,21 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
       throw input_error(manifest_path.string(), 0,
                         fmt::format("unreadable manifest: {}", e.what()));
     }
+    if (opt.resume_at >= 0 && opt.resume_at != done) {
+      if (opt.resume_at > done) {
+        throw input_error(manifest_path.string(), 0,
+                          fmt::format("cannot resume at frame {}: the run has {} complete frames",
+                                      opt.resume_at, done));
+      }
+      state_file = state_name(opt.resume_at);
+      if (!fs::exists(opt.out / state_file)) {
+        throw input_error((opt.out / state_file).string(), 0,
+                          fmt::format("no state kept for frame {} (run with --keep-states N for "
+                                      "every N-th frame's state)",
+                                      opt.resume_at));
+      }
+      done = opt.resume_at;
+    }
     int state_frame = -1;
     ClothState st = read_state(opt.out / state_file, n, state_frame);
     if (state_frame != done) {
@@ -243,6 +289,13 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
     auto& frames = manifest["frames"];
     while (!frames.empty() && frames.back().at("frame").get<int>() > done)
       frames.erase(frames.size() - 1);
+    if (manifest["complete_frames"].get<int>() != done) {
+      // The manifest commits the earlier frame first; the later files are then stale.
+      manifest["complete_frames"] = done;
+      manifest["state_file"] = state_file;
+      write_file_atomic(manifest_path, [&](std::ostream& o) { o << manifest.dump(1) << '\n'; });
+      remove_frames_after(opt.out, done, ext);
+    }
   } else {
     manifest = {{"format_version", 1},
                 {"scene", scene.name},
@@ -286,13 +339,16 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
     const int k = fst.frame;
     write_mesh_atomic(opt.out / frame_name(k, ext), sim.state().x, faces, ext);
     const std::string old_state = manifest["state_file"].get<std::string>();
+    const int old_frame = manifest["complete_frames"].get<int>();
     const std::string sname = state_name(k);
     write_state_atomic(opt.out / sname, sim.state(), k);
     manifest["frames"].push_back(to_json(fst));
     manifest["complete_frames"] = k;
     manifest["state_file"] = sname;
     write_file_atomic(manifest_path, [&](std::ostream& o) { o << manifest.dump(1) << '\n'; });
-    fs::remove(opt.out / old_state, ec);  // the manifest no longer points at it
+    const bool keep = (opt.keep_states > 0 && old_frame % opt.keep_states == 0) ||
+                      old_frame == opt.resume_at;    // the kept state a replay started from
+    if (!keep) fs::remove(opt.out / old_state, ec);  // the manifest no longer points at it
     out.push_back(fst);
     if (opt.on_frame) opt.on_frame(fst, total);
     if (!fst.finite) {

@@ -144,6 +144,57 @@ TEST(FrameIo, ResumeMatchesStraightRunBitwise) {
   EXPECT_TRUE(run_simulation(sim, opt).empty());
 }
 
+// Runs test_scene() into `out` with the given options (a fresh process would start like this).
+std::vector<FrameStats> run_into(const fs::path& out, int keep_states, bool resume,
+                                 int resume_at = -1, int frames = -1) {
+  Simulation sim(test_scene());
+  RunOptions opt;
+  opt.out = out;
+  opt.keep_states = keep_states;
+  opt.resume = resume;
+  opt.resume_at = resume_at;
+  opt.frames = frames;
+  return run_simulation(sim, opt);
+}
+
+TEST(FrameIo, ResumeAtAKeptStateReplaysTheLaterFramesBitwise) {
+  TempDir dir;
+  const fs::path straight = dir.path / "straight", kept = dir.path / "kept";
+  ASSERT_EQ(run_into(straight, 0, false).size(), 5u);
+  ASSERT_EQ(run_into(kept, 2, false).size(), 5u);
+  for (int k = 0; k <= 5; ++k) {
+    // Frames 0, 2 and 4 are kept, and the last one.
+    EXPECT_EQ(fs::exists(kept / ("state_000" + std::to_string(k) + ".bin")), k % 2 == 0 || k == 5)
+        << k;
+  }
+  // Neither a frame past the run nor one whose state was not kept can be resumed at; the
+  // folder is left as it was.
+  for (const int at : {6, 3}) {
+    EXPECT_THROW((void)run_into(kept, 0, true, at), InputError) << at;
+    EXPECT_TRUE(fs::exists(kept / "state_0005.bin"));
+  }
+  EXPECT_THROW((void)run_into(dir.path / "nothing", 0, true, 0), InputError);
+  EXPECT_FALSE(fs::exists(dir.path / "nothing"));  // no partial output
+  // Replaying from frame 2 and stopping at 3: the manifest ends at frame 3 and the later files
+  // are gone.
+  const auto frames = run_into(kept, 0, true, 2, 3);
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_EQ(frames.front().frame, 3);
+  const auto manifest = nlohmann::json::parse(slurp(kept / "manifest.json"));
+  EXPECT_EQ(manifest["complete_frames"], 3);
+  EXPECT_EQ(manifest["frames"].size(), 3u);
+  for (const char* gone : {"frame_0004.obj", "frame_0005.obj", "state_0004.bin", "state_0005.bin"})
+    EXPECT_FALSE(fs::exists(kept / gone)) << gone;
+  EXPECT_TRUE(fs::exists(kept / "state_0002.bin"));  // the state the replay started from stays
+  // Resumed to the end, the frames are those of the straight run.
+  ASSERT_EQ(run_into(kept, 0, true).size(), 2u);
+  for (int k = 0; k <= 5; ++k) {
+    const std::string name = "frame_000" + std::to_string(k) + ".obj";
+    EXPECT_EQ(slurp(straight / name), slurp(kept / name)) << name;
+  }
+  EXPECT_EQ(slurp(straight / "state_0005.bin"), slurp(kept / "state_0005.bin"));
+}
+
 TEST(FrameIo, PlyOutputHasHeaderAndBinaryBody) {
   TempDir dir;
   fs::create_directories(dir.path);

@@ -32,12 +32,19 @@ void write_state_atomic(const std::filesystem::path& path, const ClothState& sta
 
 [[nodiscard]] nlohmann::json to_json(const FrameStats& s);
 
-/// Runs a simulation into a folder: frame_NNNN.{obj,ply}, state_NNNN.bin (the last frame's only),
-/// manifest.json. With `resume`, continues from the manifest's last complete frame.
+/// Runs a simulation into a folder: frame_NNNN.{obj,ply}, state_NNNN.bin (the last frame's, and
+/// every `keep_states`-th), manifest.json. With `resume`, continues from the manifest's last
+/// complete frame, or from the kept state of frame `resume_at`.
 struct RunOptions {
   std::filesystem::path out;
   int frames = -1;  ///< -1: the scene's count
   bool resume = false;
+  /// Also keep the state of every frame that is a multiple of this (0: the last frame's only),
+  /// so that a later frame can be replayed without rerunning from frame 0.
+  int keep_states = 0;
+  /// With `resume`: continue from this frame (its state must have been kept) instead of the
+  /// last; the manifest drops the later frames, and their mesh and state files are removed.
+  int resume_at = -1;
   /// Called after every frame (progress display); may be empty.
   std::function<void(const FrameStats&, int total_frames)> on_frame;
 };
