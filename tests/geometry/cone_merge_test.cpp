@@ -18,8 +18,6 @@ using test::kCases;
 using test::Rng;
 using test::Vec3L;
 
-constexpr long double kPi = std::numbers::pi_v<long double>;
-
 // Every sampled rim point of `in` lies in `out` with no tolerance: the merge's slack must absorb
 // all rounding. Returns the number of violations.
 int count_escapes(const NormalCone& out, const NormalCone& in, Rng& rng) {
