@@ -1014,12 +1014,10 @@ struct ContactHandler::Impl {
         zone_of[i] = root_zone[r];
         members[zone_of[i]].push_back(i);
       }
-      std::vector<int> anchor_count(members.size(), 0);  // > 0: the zone is anchored
       std::fill(vertex_anchor_count.begin(), vertex_anchor_count.end(), 0);
       std::vector<std::vector<int>> zone_anchors(members.size());
       for (std::size_t a = 0; a < anchors.size(); ++a) {
         const int i = anchors[a].vertex;
-        ++anchor_count[zone_of[i]];
         zone_anchors[zone_of[i]].push_back(static_cast<int>(a));
         ++vertex_anchor_count[i];
       }
@@ -1028,9 +1026,10 @@ struct ContactHandler::Impl {
       for (std::size_t z = 0; z < members.size(); ++z) {
         const auto& m = members[z];
         st.largest_zone = std::max(st.largest_zone, static_cast<int>(m.size()));
+        bool anchored = !zone_anchors[z].empty();  // touches the body or a pin
         for (int i : m) {
           changed[i] = 1;
-          if (inv_mass[i] == 0.0) ++anchor_count[z];
+          anchored = anchored || inv_mass[i] == 0.0;
         }
         // The zone moves rigidly (an invertible linear map of its start positions over the
         // substep, so nothing inside it can collide): free zones keep their momentum and angular
@@ -1045,7 +1044,7 @@ struct ContactHandler::Impl {
         std::vector<Vec3> points, velocities;
         std::vector<double> weights;
         for (int i : m) {
-          if (anchor_count[z] == 0) {
+          if (!anchored) {
             points.push_back(x0[i]);
             velocities.push_back(v[i]);
             weights.push_back(mass[i]);

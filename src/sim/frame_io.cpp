@@ -3,7 +3,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cmath>
@@ -24,32 +23,6 @@ std::string frame_name(int frame, const std::string& ext) {
 }
 std::string state_name(int frame) {
   return fmt::format("state_{:04d}.bin", frame);
-}
-
-// The frame number of `name` when it is `prefix` + digits + `suffix`, else -1.
-int numbered(const std::string& name, const std::string& prefix, const std::string& suffix) {
-  if (name.size() <= prefix.size() + suffix.size() || !name.starts_with(prefix) ||
-      !name.ends_with(suffix))
-    return -1;
-  const std::string digits =
-      name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
-  if (digits.size() > 9 ||
-      !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
-    return -1;
-  return std::stoi(digits);
-}
-
-// Removes the mesh and state files of frames after `frame` (left by a run resumed earlier).
-void remove_frames_after(const std::filesystem::path& dir, int frame, const std::string& ext) {
-  std::vector<std::filesystem::path> stale;
-  for (const auto& e : std::filesystem::directory_iterator(dir)) {
-    const std::string name = e.path().filename().string();
-    if (numbered(name, "state_", ".bin") > frame || numbered(name, "frame_", "." + ext) > frame)
-      stale.push_back(e.path());
-  }
-  std::error_code ec;
-  for (const auto& p : stale)
-    std::filesystem::remove(p, ec);
 }
 
 template <typename T>
@@ -289,12 +262,15 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
     auto& frames = manifest["frames"];
     while (!frames.empty() && frames.back().at("frame").get<int>() > done)
       frames.erase(frames.size() - 1);
-    if (manifest["complete_frames"].get<int>() != done) {
+    if (const int last = manifest["complete_frames"].get<int>(); last != done) {
       // The manifest commits the earlier frame first; the later files are then stale.
       manifest["complete_frames"] = done;
       manifest["state_file"] = state_file;
       write_file_atomic(manifest_path, [&](std::ostream& o) { o << manifest.dump(1) << '\n'; });
-      remove_frames_after(opt.out, done, ext);
+      for (int k = done + 1; k <= last; ++k) {
+        fs::remove(opt.out / frame_name(k, ext), ec);
+        fs::remove(opt.out / state_name(k), ec);
+      }
     }
   } else {
     manifest = {{"format_version", 1},
