@@ -1060,9 +1060,12 @@ struct ContactHandler::Impl {
           velocities.push_back(an.velocity);
           weights.push_back(1.0 / vertex_anchor_count[an.vertex]);
         }
-        const detail::RigidMotion rm = detail::fit_rigid(points, velocities, weights);
+        std::optional<detail::AffineMotion> am;
+        if (anchored && opt.affine_zones) am = detail::fit_affine(points, velocities, weights, h);
+        const detail::RigidMotion rm =
+            am ? detail::RigidMotion{} : detail::fit_rigid(points, velocities, weights);
         for (int i : m) {
-          if (inv_mass[i] != 0.0) v[i] = rm.at(x0[i]);
+          if (inv_mass[i] != 0.0) v[i] = am ? am->at(x0[i]) : rm.at(x0[i]);
         }
       }
       active = flagged(changed);

@@ -295,6 +295,7 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                              {"repulsion_fraction", c.repulsion_fraction},
                              {"repulsion_sweeps", c.repulsion_sweeps},
                              {"untangle_step", c.untangle_step},
+                             {"zone_motion", c.affine_zones ? "affine" : "rigid"},
                              {"friction", c.friction}};
     }
     if (scene.count_intersections) {

@@ -428,6 +428,8 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     c.repulsion_sweeps = o.integer("repulsion_sweeps", c.repulsion_sweeps, 1, 1000);
     c.full_passes = boolean("full_passes", c.full_passes);
     c.untangle_step = o.number("untangle_step", c.untangle_step, 0.0, 1.0);
+    c.affine_zones = o.string("zone_motion", c.affine_zones ? "affine" : "rigid",
+                              {"rigid", "affine"}) == "affine";
     s.count_intersections = boolean("count_intersections", s.count_intersections);
     o.finish();
   }

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 
+#include <cmath>
+
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 
 namespace clothcd::sim::detail {
 
@@ -32,6 +35,34 @@ RigidMotion fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
     a[k] = ev[k] > 1e-12 * std::max(ev[2], 1e-300) ? a[k] / ev[k] : 0.0;
   r.omega = es.eigenvectors() * a;
   return r;
+}
+
+std::optional<AffineMotion> fit_affine(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                                       const std::vector<double>& w, double h,
+                                       const AffineLimits& limits) {
+  AffineMotion m;
+  double wt = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    wt += w[i];
+    m.xc += w[i] * x[i];
+    m.vc += w[i] * v[i];
+  }
+  if (!(wt > 0.0) || x.size() < 4) return std::nullopt;
+  m.xc /= wt;
+  m.vc /= wt;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero(), cross = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const Vec3 d = x[i] - m.xc;
+    cov += w[i] * d * d.transpose();
+    cross += w[i] * (v[i] - m.vc) * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  const Vec3 ev = es.eigenvalues();  // ascending
+  if (!(ev[0] > limits.min_flatness * limits.min_flatness * ev[2])) return std::nullopt;
+  m.a = cross * es.eigenvectors() * ev.cwiseInverse().asDiagonal() * es.eigenvectors().transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h * m.a);
+  if (!(svd.singularValues()[0] < limits.max_strain) || !m.a.allFinite()) return std::nullopt;
+  return m;
 }
 
 }  // namespace clothcd::sim::detail

@@ -301,5 +301,82 @@ TEST(ContactHandler, AnchoredZoneFollowsTheBodyWhereItTouchesIt) {
   EXPECT_GT(n.dot(body1[4] - s.x1[0]), 0.0);
 }
 
+// A cloth folded at a right angle (face A in the plane y = 0, face B in x = 0, sharing the z
+// axis) held between spike tips 1.5 mm either side of each face at four points, while the body
+// shears: each point moves by S p with S = [[0, s, 0], [s, 0, 0], [0, 0, 0]], 2-6 mm across the
+// faces. The anchors span a volume and follow an affine field that no rigid motion matches.
+struct FoldInShearingBody {
+  ClothModel cloth;
+  std::vector<Vec3> body, body1;
+  std::vector<Face> faces;
+  std::vector<std::pair<int, int>> sandwiches;  // (tip on the - side, tip on the + side)
+
+  static ClothMeshInput fold() {
+    ClothMeshInput in;
+    in.positions = {{0, 0, 0.5}, {0, 0, -0.5}, {0.45, 0, 0}, {0, 0.45, 0}};
+    in.faces = {{0, 1, 2}, {0, 3, 1}};
+    return in;
+  }
+
+  explicit FoldInShearingBody(double s) : cloth(fold(), ClothMaterial{}) {
+    const Vec3 y(0, 1, 0), x(1, 0, 0);
+    for (const auto& [p, n] : {std::pair{Vec3(0.1, 0, 0.1), y},
+                               {Vec3(0.3, 0, 0.1), y},
+                               {Vec3(0, 0.1, -0.1), x},
+                               {Vec3(0, 0.3, -0.1), x}}) {
+      const Vec3 t1 = n.cross(Vec3(0, 0, 1)), t2 = n.cross(t1);
+      std::array<int, 2> tips{};
+      for (int k = 0; k < 2; ++k) {
+        const double side = k == 0 ? -1.0 : 1.0;
+        const int b = static_cast<int>(body.size());
+        tips[k] = b;
+        const Vec3 base = p + 0.05 * side * n;
+        body.insert(body.end(), {p + 0.0015 * side * n, base + 0.01 * t1,
+                                 base - 0.005 * t1 + 0.01 * t2, base - 0.005 * t1 - 0.01 * t2});
+        faces.insert(faces.end(), {{b, b + 1, b + 2}, {b, b + 2, b + 3}, {b, b + 3, b + 1}});
+      }
+      sandwiches.emplace_back(tips[0], tips[1]);
+    }
+    for (const Vec3& b : body)
+      body1.push_back(b + s * Vec3(b.y(), b.x(), 0.0));
+  }
+
+  // Each sandwich's tips end on either side of the face they hold.
+  [[nodiscard]] bool held(const std::vector<Vec3>& x1) const {
+    const std::array<std::array<int, 3>, 2> f{{{0, 1, 2}, {0, 3, 1}}};
+    for (std::size_t q = 0; q < sandwiches.size(); ++q) {
+      const auto& t = f[q < 2 ? 0 : 1];
+      const Vec3 n = (x1[t[1]] - x1[t[0]]).cross(x1[t[2]] - x1[t[0]]);
+      const double below = n.dot(body1[sandwiches[q].first] - x1[t[0]]);
+      const double above = n.dot(body1[sandwiches[q].second] - x1[t[0]]);
+      if (!(below * above < 0.0)) return false;
+    }
+    return true;
+  }
+};
+
+TEST(ContactHandler, AnchoredZoneFollowsABodyThatShears) {
+  const FoldInShearingBody scene(0.02);
+  ContactOptions opt;
+  opt.ccd_iterations = 0;  // straight to the zones ...
+  opt.full_passes = true;  // ... testing every pair in each round
+  const auto run = [&](bool affine) {
+    opt.affine_zones = affine;
+    return one_step(scene.cloth, std::vector<Vec3>(4, Vec3::Zero()), 0.01, scene.body, &scene.faces,
+                    scene.body1, opt);
+  };
+  IntersectionCounter c(scene.cloth.topology(), {}, scene.faces,
+                        static_cast<int>(scene.body.size()));
+  const OneStep affine = run(true);
+  EXPECT_GT(affine.stats.zone_rounds, 0);
+  EXPECT_EQ(affine.stats.unresolved, 0);
+  EXPECT_TRUE(c.body_pairs(affine.x1, scene.body1).empty());
+  EXPECT_TRUE(scene.held(affine.x1));
+  // The rigid zone cannot follow it: hits are left and tips go through.
+  const OneStep rigid = run(false);
+  EXPECT_GT(rigid.stats.unresolved, 0);
+  EXPECT_FALSE(scene.held(rigid.x1));
+}
+
 }  // namespace
 }  // namespace clothcd::sim

@@ -44,6 +44,13 @@ TEST(Scene, SmallGridParses) {
   EXPECT_EQ(s.frames, 2);
 }
 
+TEST(Scene, ZoneMotionIsAffineUnlessTheSceneSaysRigid) {
+  json j = small_grid_scene();
+  EXPECT_TRUE(parse_scene(j, "test-scene.json").contact.affine_zones);
+  j["collisions"] = {{"zone_motion", "rigid"}};
+  EXPECT_FALSE(parse_scene(j, "test-scene.json").contact.affine_zones);
+}
+
 TEST(Scene, ValidationErrorsNameFileAndKey) {
   struct Case {
     const char* name;
@@ -86,6 +93,11 @@ TEST(Scene, ValidationErrorsNameFileAndKey) {
          j["body"] = {{"type", "cube"}};
        },
        "'body.type'"},
+      {"bad zone motion",
+       [](json& j) {
+         j["collisions"] = {{"zone_motion", "bent"}};
+       },
+       "'collisions.zone_motion': 'bent' is not one of"},
       {"frames without placeholder",
        [](json& j) {
          j["body"] = {{"type", "frames"}, {"frames", "x.obj"}, {"count", 2}};

@@ -41,6 +41,10 @@ struct ContactOptions {
   /// 51-53, but resumed inside multilayer-kick's deep tangle of frame 72 it gave 803 and 813
   /// crossings where the run without it had 619.
   double untangle_step = 0.0;
+  /// Impact zones touching the body or a pin follow the affine motion nearest their anchors'
+  /// velocities where the anchors determine one (not flat, strain |h A| under 0.2), else the
+  /// rigid one; false: always the rigid one. Free zones are rigid either way.
+  bool affine_zones = true;
   double friction = 0.2;  ///< Coulomb coefficient of the contact impulses
 };
 
