@@ -110,6 +110,12 @@ const bool registered = clothcd::app::register_command(
                               sim.scene().contact.self, sim.scene().contact.body,
                               sim.scene().contact.thickness, sim.scene().contact.ccd_iterations)
                 : std::string("none"));
+        if (const auto& r = sim.initial_repair(); r.pairs_before > 0) {
+          fmt::print(stderr,
+                     "starting shape: {} self-crossing pairs, {} after moving {} vertices (at most "
+                     "{:.3f} mm)\n",
+                     r.pairs_before, r.pairs_after, r.moves, 1e3 * r.largest_move);
+        }
         clothcd::sim::RunOptions opt;
         opt.out = args->out;
         opt.frames = args->frames;

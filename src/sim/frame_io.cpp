@@ -298,6 +298,12 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                              {"zone_motion", c.affine_zones ? "affine" : "rigid"},
                              {"friction", c.friction}};
     }
+    if (const CrossingRepair& r = sim.initial_repair(); r.pairs_before > 0) {
+      manifest["initial_repair"] = {{"self_pairs_before", r.pairs_before},
+                                    {"self_pairs_after", r.pairs_after},
+                                    {"vertices_moved", r.moves},
+                                    {"largest_move", r.largest_move}};
+    }
     if (scene.count_intersections) {
       const IntersectionCount ic = sim.count_intersections();
       manifest["initial_self_intersections"] = ic.self;

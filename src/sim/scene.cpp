@@ -430,6 +430,7 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     c.untangle_step = o.number("untangle_step", c.untangle_step, 0.0, 1.0);
     c.affine_zones = o.string("zone_motion", c.affine_zones ? "affine" : "rigid",
                               {"rigid", "affine"}) == "affine";
+    s.repair_initial_crossings = boolean("repair_initial_crossings", s.repair_initial_crossings);
     s.count_intersections = boolean("count_intersections", s.count_intersections);
     o.finish();
   }

@@ -21,6 +21,15 @@ Simulation::Simulation(Scene scene) : scene_(std::move(scene)) {
                                                    scene_.body ? scene_.body->faces() : kNoFaces,
                                                    scene_.body ? scene_.body->num_vertices() : 0);
   state_ = solver_->initial_state();
+  if (scene_.collisions && scene_.contact.self && scene_.repair_initial_crossings) {
+    std::vector<std::uint8_t> pinned(state_.x.size(), 0);
+    for (const PinGroup& g : scene_.pins) {
+      for (int v : g.vertices)
+        pinned[v] = 1;
+    }
+    initial_repair_ = repair_self_crossings(state_.x, *counter_, model_->topology(), pinned,
+                                            0.1 * scene_.contact.thickness);
+  }
 }
 
 Simulation::~Simulation() = default;

@@ -1,13 +1,14 @@
 // The intersection counter: the triangle test on hand-built cases, and the BVH-accelerated
-// counts equal to testing every pair on crumpled random meshes.
+// counts equal to testing every pair on crumpled random meshes. The repair of a starting shape's
+// self crossings.
 #include "clothcd/sim/intersections.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
-
 #include <random>
 
+#include "clothcd/sim/simulation.hpp"
 #include "grid.hpp"
 
 namespace clothcd::sim {
@@ -114,6 +115,82 @@ TEST(SeamLinks, JoinNearbyVerticesOfAStitchChainOnly) {
   // from the seam still is.
   IntersectionCounter counter(m.topology(), links, {}, 0);
   EXPECT_TRUE(counter.self_pairs(m.initial_positions()).empty());
+}
+
+// Two 4 x 4 grids 2 mm apart (the upper one's vertices offset by 25), one vertex of the upper
+// grid pushed 0.4 mm through the lower one: the faces around it cross the lower grid's faces.
+ClothMeshInput pierced_sheets() {
+  ClothMeshInput in = test::grid_cloth(4, 4, 0.04, 0.04);
+  const ClothMeshInput up = test::grid_cloth(4, 4, 0.04, 0.04, 0.002);
+  const int n = static_cast<int>(in.positions.size());
+  for (const Vec3& p : up.positions)
+    in.positions.push_back(p + Vec3(0.003, 0.0, 0.004));
+  for (const Face& f : up.faces)
+    in.faces.push_back({f[0] + n, f[1] + n, f[2] + n});
+  in.positions[n + 12].y() = -0.0004;  // the upper grid's middle vertex (2, 2): vertex 37
+  return in;
+}
+
+TEST(CrossingRepair, MovesThePiercingVertexBackThroughAndNothingElse) {
+  ClothMeshInput in = pierced_sheets();
+  const Topology cloth(in.faces, static_cast<int>(in.positions.size()));
+  IntersectionCounter counter(cloth, {}, {}, 0);
+  std::vector<Vec3> x = in.positions;
+  const CrossingRepair r = repair_self_crossings(x, counter, cloth, {}, 1e-4);
+  EXPECT_GT(r.pairs_before, 0);
+  EXPECT_EQ(r.pairs_after, 0);
+  EXPECT_TRUE(counter.self_pairs(x).empty());
+  EXPECT_EQ(r.moves, 1);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (i != 37) {
+      EXPECT_EQ(x[i], in.positions[i]) << i;
+    }
+  }
+  // Straight up through the lower plane to the margin above it: 0.5 mm.
+  EXPECT_NEAR(x[37].y(), 1e-4, 1e-12);
+  EXPECT_NEAR(r.largest_move, 5e-4, 1e-12);
+}
+
+TEST(CrossingRepair, NeverMovesFixedVerticesNorAddsPairs) {
+  ClothMeshInput in = pierced_sheets();
+  const Topology cloth(in.faces, static_cast<int>(in.positions.size()));
+  IntersectionCounter counter(cloth, {}, {}, 0);
+  std::vector<Vec3> x = in.positions;
+  std::vector<std::uint8_t> fixed(x.size(), 0);
+  fixed[37] = 1;
+  const CrossingRepair r = repair_self_crossings(x, counter, cloth, fixed, 1e-4);
+  EXPECT_EQ(x[37], in.positions[37]);
+  EXPECT_LE(r.pairs_after, r.pairs_before);
+  EXPECT_EQ(static_cast<long long>(counter.self_pairs(x).size()), r.pairs_after);
+  // A shape without crossings is left alone.
+  const ClothMeshInput flat = test::grid_cloth(4, 4, 0.04, 0.04);
+  const Topology flat_t(flat.faces, static_cast<int>(flat.positions.size()));
+  IntersectionCounter flat_c(flat_t, {}, {}, 0);
+  std::vector<Vec3> y = flat.positions;
+  const CrossingRepair none = repair_self_crossings(y, flat_c, flat_t, {}, 1e-4);
+  EXPECT_EQ(none.pairs_before, 0);
+  EXPECT_EQ(none.moves, 0);
+  EXPECT_EQ(y, flat.positions);
+}
+
+TEST(CrossingRepair, SimulationStartsFromTheRepairedShapeUnlessTheSceneSaysNo) {
+  for (const bool repair : {true, false}) {
+    Scene s;
+    s.name = "pierced";
+    s.cloth = pierced_sheets();
+    s.collisions = true;
+    s.repair_initial_crossings = repair;
+    Simulation sim(std::move(s));
+    const IntersectionCount c = sim.count_intersections();
+    if (repair) {
+      EXPECT_GT(sim.initial_repair().pairs_before, 0);
+      EXPECT_EQ(sim.initial_repair().pairs_after, 0);
+      EXPECT_EQ(c.self, 0);
+    } else {
+      EXPECT_EQ(sim.initial_repair().moves, 0);
+      EXPECT_GT(c.self, 0);
+    }
+  }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 /// sharing a vertex or tied by a seam link are skipped) and the cloth with the body. A BVH
 /// prefilter (clothcd::Bvh, static boxes) feeds a discrete triangle-triangle test.
 
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <utility>
@@ -44,5 +45,23 @@ class IntersectionCounter {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// What repair_self_crossings did.
+struct CrossingRepair {
+  long long pairs_before = 0, pairs_after = 0;  ///< intersecting self pairs
+  int moves = 0;                                ///< vertex moves kept
+  double largest_move = 0.0;                    ///< m
+};
+
+/// Undoes self crossings of a cloth's starting shape (an input drape whose panels cross at a
+/// seam: the collision stage leaves crossing pairs out and nothing else would undo them). For
+/// each crossing pair, the vertex that lies alone on its side of the other triangle's plane, the
+/// nearer of the two pairs' such vertices first, moves through that plane to `margin` beyond it
+/// along its normal, which separates the pair; vertices flagged in `fixed` never move. A move
+/// is kept only when it lowers the count of crossing pairs, so the result never has more pairs
+/// than the input. Stops when no pair is left or no move helps, after at most `max_tries` moves.
+CrossingRepair repair_self_crossings(std::span<Vec3> x, IntersectionCounter& counter,
+                                     const Topology& cloth, std::span<const std::uint8_t> fixed,
+                                     double margin, int max_tries = 200);
 
 }  // namespace clothcd::sim

@@ -54,6 +54,9 @@ struct Scene {
   /// The collision stage (`collisions` key); off when the scene has no such key.
   bool collisions = false;
   ContactOptions contact;
+  /// Undo self crossings of the starting shape (`collisions.repair_initial_crossings`; only with
+  /// self collisions): repair_self_crossings with a margin of 0.1 `thickness`.
+  bool repair_initial_crossings = true;
   /// Count intersecting triangle pairs after every frame (`collisions.count_intersections`).
   bool count_intersections = true;
 };

@@ -63,6 +63,9 @@ class Simulation {
 
   FrameStats advance_frame();
 
+  /// What the constructor's repair of the starting shape did (Scene::repair_initial_crossings).
+  [[nodiscard]] const CrossingRepair& initial_repair() const { return initial_repair_; }
+
   /// Intersecting triangle pairs (cloth-cloth, cloth-body) at the current state and time.
   [[nodiscard]] IntersectionCount count_intersections();
   /// The body's vertices at the current time (empty without a body).
@@ -75,6 +78,7 @@ class Simulation {
   std::unique_ptr<ClothModel> model_;
   std::unique_ptr<ClothSolver> solver_;
   ClothState state_;
+  CrossingRepair initial_repair_;
   int frame_ = 0;
 };
 
