@@ -1,26 +1,37 @@
 #include "zone_motion.hpp"
 
 #include <algorithm>
-
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
 namespace clothcd::sim::detail {
+namespace {
+
+// The weighted centroid and mean velocity, or false when the weights sum to nothing.
+bool weighted_means(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
+                    const std::vector<double>& w, Vec3& xc, Vec3& vc) {
+  double wt = 0.0;
+  xc.setZero();
+  vc.setZero();
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    wt += w[i];
+    xc += w[i] * x[i];
+    vc += w[i] * v[i];
+  }
+  if (!(wt > 0.0)) return false;
+  xc /= wt;
+  vc /= wt;
+  return true;
+}
+
+}  // namespace
 
 RigidMotion fit_rigid(const std::vector<Vec3>& x, const std::vector<Vec3>& v,
                       const std::vector<double>& w) {
   RigidMotion r;
-  double wt = 0.0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    wt += w[i];
-    r.xc += w[i] * x[i];
-    r.vc += w[i] * v[i];
-  }
-  if (!(wt > 0.0)) return r;
-  r.xc /= wt;
-  r.vc /= wt;
+  if (!weighted_means(x, v, w, r.xc, r.vc)) return RigidMotion{};
   Vec3 l = Vec3::Zero();
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
   for (std::size_t i = 0; i < x.size(); ++i) {
@@ -41,15 +52,7 @@ std::optional<AffineMotion> fit_affine(const std::vector<Vec3>& x, const std::ve
                                        const std::vector<double>& w, double h,
                                        const AffineLimits& limits) {
   AffineMotion m;
-  double wt = 0.0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    wt += w[i];
-    m.xc += w[i] * x[i];
-    m.vc += w[i] * v[i];
-  }
-  if (!(wt > 0.0) || x.size() < 4) return std::nullopt;
-  m.xc /= wt;
-  m.vc /= wt;
+  if (x.size() < 4 || !weighted_means(x, v, w, m.xc, m.vc)) return std::nullopt;
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero(), cross = Eigen::Matrix3d::Zero();
   for (std::size_t i = 0; i < x.size(); ++i) {
     const Vec3 d = x[i] - m.xc;
