@@ -939,8 +939,8 @@ struct ContactHandler::Impl {
     }
   }
 
-  // Rigid impact zones (Provot 1997); a zone touching the body or a pinned vertex moves with the
-  // mean velocity of those anchors (body points have infinite mass).
+  // Impact zones (Provot 1997), each moved by one invertible linear map; a zone touching the
+  // body or a pinned vertex follows those anchors (body points have infinite mass).
   void zones(const SubstepContext& ctx, std::span<Vec3> v, std::vector<std::uint8_t>& changed,
              CollisionStats& st) {
     const int n = model.num_vertices();
@@ -1031,10 +1031,12 @@ struct ContactHandler::Impl {
           changed[i] = 1;
           anchored = anchored || inv_mass[i] == 0.0;
         }
-        // The zone moves rigidly (an invertible linear map of its start positions over the
-        // substep, so nothing inside it can collide): free zones keep their momentum and angular
-        // momentum (Provot 1997); zones touching the body or a pin take the rigid motion closest
-        // to the body's velocities at the points they touch (and the pins'). Fitted at the cloth
+        // The zone moves by an invertible linear map of its start positions over the substep, so
+        // nothing inside it can collide: free zones move rigidly and keep their momentum and
+        // angular momentum (Provot 1997); zones touching the body or a pin take the affine motion
+        // closest to the body's velocities at the points they touch (and the pins') where those
+        // fix one, else the rigid one. Affine, multilayer-kick held frames 67-70 where rigid
+        // zones gave up (a body that bends is not rigid under a zone). Fitted at the cloth
         // vertices instead, each given its contacts' body velocity, the fit was off wherever a
         // body point touched a long cloth edge or face: on multilayer-kick frame 69 (stretch 12)
         // one contact anchored vertices 12 cm apart to one velocity on a turning leg, the fit
