@@ -55,11 +55,12 @@ struct CrossingRepair {
 
 /// Undoes self crossings of a cloth's starting shape (an input drape whose panels cross at a
 /// seam: the collision stage leaves crossing pairs out and nothing else would undo them). For
-/// each crossing pair, the vertex that lies alone on its side of the other triangle's plane, the
-/// nearer of the two pairs' such vertices first, moves through that plane to `margin` beyond it
-/// along its normal, which separates the pair; vertices flagged in `fixed` never move. A move
-/// is kept only when it lowers the count of crossing pairs, so the result never has more pairs
-/// than the input. Stops when no pair is left or no move helps, after at most `max_tries` moves.
+/// each crossing pair, the vertex that lies alone on its side of the other triangle's plane (of
+/// the pair's two such vertices, the nearer to its plane first) moves through that plane to
+/// `margin` beyond it along its normal, which separates the pair; vertices flagged in `fixed`
+/// never move. A move is kept only when it lowers the count of crossing pairs, so the result
+/// never has more pairs than the input. Stops when no pair is left or no move helps, after at most
+/// `max_tries` moves.
 CrossingRepair repair_self_crossings(std::span<Vec3> x, IntersectionCounter& counter,
                                      const Topology& cloth, std::span<const std::uint8_t> fixed,
                                      double margin, int max_tries = 200);
