@@ -283,6 +283,12 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                 {"slivers", sim.model().num_slivers()},
                 {"stitches", sim.model().stitches().size()},
                 {"collisions", scene.collisions},
+                {"solver",
+                 {{"pcg_max_iterations", scene.solver.pcg_max_iterations},
+                  {"pcg_tolerance", scene.solver.pcg_tolerance},
+                  {"halve_residual", scene.solver.halve_residual},
+                  {"max_halvings", scene.solver.max_halvings},
+                  {"halve_unresolved", scene.solver.halve_unresolved}}},
                 {"frames", nlohmann::json::array()}};
     if (scene.collisions) {
       const ContactOptions& c = scene.contact;

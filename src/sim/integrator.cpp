@@ -148,11 +148,13 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
     stats.collision.ccd_passes += cs.ccd_passes;
     stats.collision.zones += cs.zones;
     stats.collision.zone_rounds += cs.zone_rounds;
-    stats.collision.unresolved += cs.unresolved;
     stats.collision.excluded += cs.excluded;
     stats.collision.largest_zone = std::max(stats.collision.largest_zone, cs.largest_zone);
     stats.collision.seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // Hits left by a halved attempt are not counted: its shorter substeps retry them.
+    if (!allow_fail && options_.halve_unresolved && cs.unresolved > 0) return false;
+    stats.collision.unresolved += cs.unresolved;
   }
   for_each_vertex(n, [&](int i) {
     state.x[i] += h * v_star[i];

@@ -55,6 +55,12 @@ class ObjectReader {
     if (d < lo || d > hi) fail(key(k), fmt::format("{} is outside [{}, {}]", d, lo, hi));
     return static_cast<int>(d);
   }
+  bool boolean(const std::string& k, bool def) {
+    if (!has(k)) return def;
+    const json& v = j_.at(k);
+    if (!v.is_boolean()) fail(key(k), fmt::format("expected true or false, got {}", v.dump()));
+    return v.get<bool>();
+  }
   std::string string(const std::string& k, const std::string& def,
                      std::set<std::string> allowed = {}) {
     if (!has(k)) {
@@ -323,6 +329,7 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     s.solver.pcg_tolerance = o.number("pcg_tolerance", s.solver.pcg_tolerance, 0.0, 1.0);
     s.solver.halve_residual = o.number("halve_residual", s.solver.halve_residual, 0.0, INFINITY);
     s.solver.max_halvings = o.integer("max_halvings", s.solver.max_halvings, 0, 10);
+    s.solver.halve_unresolved = o.boolean("halve_unresolved", s.solver.halve_unresolved);
     o.finish();
   }
   if (top.has("substeps")) {
@@ -409,29 +416,22 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
   }
   if (top.has("collisions")) {
     ObjectReader o = top.object("collisions");
-    auto boolean = [&](const std::string& k, bool def) {
-      if (!o.has(k)) return def;
-      const json& v = o.get(k);
-      if (!v.is_boolean())
-        o.fail(o.key(k), fmt::format("expected true or false, got {}", v.dump()));
-      return v.get<bool>();
-    };
     ContactOptions& c = s.contact;
-    s.collisions = boolean("enabled", true);
-    c.self = boolean("self", c.self);
-    c.body = boolean("body", c.body);
+    s.collisions = o.boolean("enabled", true);
+    c.self = o.boolean("self", c.self);
+    c.body = o.boolean("body", c.body);
     c.thickness = o.number("thickness", c.thickness, 0.0, 1.0);
     c.ccd_thickness = o.number("ccd_thickness", c.ccd_thickness, 0.0, 1.0);
     c.ccd_iterations = o.integer("ccd_iterations", c.ccd_iterations, 1, 1000);
     c.zone_rounds = o.integer("zone_rounds", c.zone_rounds, 0, 10000);
     c.repulsion_fraction = o.number("repulsion_fraction", c.repulsion_fraction, 0.0, 1.0);
     c.repulsion_sweeps = o.integer("repulsion_sweeps", c.repulsion_sweeps, 1, 1000);
-    c.full_passes = boolean("full_passes", c.full_passes);
+    c.full_passes = o.boolean("full_passes", c.full_passes);
     c.untangle_step = o.number("untangle_step", c.untangle_step, 0.0, 1.0);
     c.affine_zones = o.string("zone_motion", c.affine_zones ? "affine" : "rigid",
                               {"rigid", "affine"}) == "affine";
-    s.repair_initial_crossings = boolean("repair_initial_crossings", s.repair_initial_crossings);
-    s.count_intersections = boolean("count_intersections", s.count_intersections);
+    s.repair_initial_crossings = o.boolean("repair_initial_crossings", s.repair_initial_crossings);
+    s.count_intersections = o.boolean("count_intersections", s.count_intersections);
     o.finish();
   }
   s.contact.friction = s.material.friction;

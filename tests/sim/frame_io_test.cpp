@@ -136,6 +136,11 @@ TEST(FrameIo, ResumeMatchesStraightRunBitwise) {
   ASSERT_EQ(manifest["frames"].size(), 5u);
   for (int k = 0; k < 5; ++k)
     EXPECT_EQ(manifest["frames"][k]["frame"], k + 1);
+  // The header records the solver settings the frames were made with.
+  const Scene scene = test_scene();
+  EXPECT_EQ(manifest["solver"]["max_halvings"], scene.solver.max_halvings);
+  EXPECT_EQ(manifest["solver"]["halve_unresolved"], scene.solver.halve_unresolved);
+  EXPECT_EQ(manifest["solver"]["pcg_tolerance"], scene.solver.pcg_tolerance);
   // Resuming a finished run does nothing.
   Simulation sim(test_scene());
   RunOptions opt;

@@ -4,7 +4,10 @@
 
 #include <cmath>
 #include <random>
+#include <span>
+#include <vector>
 
+#include "clothcd/sim/collision.hpp"
 #include "clothcd/sim/integrator.hpp"
 #include "grid.hpp"
 #include "hash.hpp"
@@ -193,6 +196,82 @@ TEST(Integrator, BitwiseDeterministicAcrossRunsAndThreadCounts) {
   const std::uint64_t a = run_hash(2);
   EXPECT_EQ(a, run_hash(2));
   EXPECT_EQ(a, run_hash(1));
+}
+
+// A handler that leaves `unresolved` hits in every substep longer than `longest` and records the
+// substeps it was asked to respond to.
+class UnresolvedAboveLength : public CollisionHandler {
+ public:
+  UnresolvedAboveLength(double longest, long long unresolved)
+      : longest_(longest), unresolved_(unresolved) {}
+  void prepare(const SubstepContext&) override {}
+  CollisionStats respond(const SubstepContext& ctx, std::span<Vec3>) override {
+    lengths.push_back(ctx.h);
+    CollisionStats st;
+    if (ctx.h > longest_) st.unresolved = unresolved_;
+    return st;
+  }
+  std::vector<double> lengths;
+
+ private:
+  double longest_;
+  long long unresolved_;
+};
+
+TEST(Integrator, SubstepWithUnresolvedHitsIsHalvedUntilResolved) {
+  const ClothModel m(grid_cloth(4, 4, 0.2, 0.2, 1.0), ClothMaterial{});
+  SolverOptions opt;
+  opt.pcg_tolerance = 1e-12;
+  const double h = 0.008;
+  // Halving on: 8 ms fails, both 4 ms halves fail, the four 2 ms quarters pass.
+  ClothSolver halving(m, opt);
+  UnresolvedAboveLength handler(0.0025, 7);
+  halving.set_collision_handler(&handler);
+  ClothState s = halving.initial_state();
+  const StepStats st = halving.step(s, h);
+  EXPECT_EQ(handler.lengths, (std::vector<double>{h, h / 2, h / 4, h / 4, h / 2, h / 4, h / 4}));
+  EXPECT_EQ(st.halvings, 3);
+  EXPECT_EQ(st.solves, 7);
+  EXPECT_EQ(st.collision.unresolved, 0);  // the failed attempts' hits are not counted
+  EXPECT_DOUBLE_EQ(s.time, h);
+  // The state is that of four plain quarter steps: failed attempts leave it untouched.
+  ClothSolver plain(m, opt);
+  ClothState q = plain.initial_state();
+  for (int k = 0; k < 4; ++k)
+    plain.step(q, h / 4);
+  for (int i = 0; i < m.num_vertices(); ++i) {
+    EXPECT_EQ(s.x[i], q.x[i]) << i;
+    EXPECT_EQ(s.v[i], q.v[i]) << i;
+  }
+}
+
+TEST(Integrator, UnresolvedHitsAreAcceptedAtTheLastHalvingOrWhenHalvingIsOff) {
+  const ClothModel m(grid_cloth(4, 4, 0.2, 0.2, 1.0), ClothMaterial{});
+  SolverOptions opt;
+  opt.max_halvings = 1;
+  {
+    // Never resolved: the two halves are the last chance and keep their hits.
+    ClothSolver solver(m, opt);
+    UnresolvedAboveLength handler(0.0, 5);
+    solver.set_collision_handler(&handler);
+    ClothState s = solver.initial_state();
+    const StepStats st = solver.step(s, 0.01);
+    EXPECT_EQ(handler.lengths, (std::vector<double>{0.01, 0.005, 0.005}));
+    EXPECT_EQ(st.halvings, 1);
+    EXPECT_EQ(st.collision.unresolved, 10);
+    EXPECT_DOUBLE_EQ(s.time, 0.01);
+  }
+  {
+    opt.halve_unresolved = false;
+    ClothSolver solver(m, opt);
+    UnresolvedAboveLength handler(0.0, 5);
+    solver.set_collision_handler(&handler);
+    ClothState s = solver.initial_state();
+    const StepStats st = solver.step(s, 0.01);
+    EXPECT_EQ(handler.lengths, std::vector<double>{0.01});
+    EXPECT_EQ(st.halvings, 0);
+    EXPECT_EQ(st.collision.unresolved, 5);
+  }
 }
 
 }  // namespace

@@ -51,6 +51,13 @@ TEST(Scene, ZoneMotionIsAffineUnlessTheSceneSaysRigid) {
   EXPECT_FALSE(parse_scene(j, "test-scene.json").contact.affine_zones);
 }
 
+TEST(Scene, UnresolvedHitsHalveTheSubstepUnlessTheSceneSaysNot) {
+  json j = small_grid_scene();
+  EXPECT_TRUE(parse_scene(j, "test-scene.json").solver.halve_unresolved);
+  j["solver"] = {{"halve_unresolved", false}};
+  EXPECT_FALSE(parse_scene(j, "test-scene.json").solver.halve_unresolved);
+}
+
 TEST(Scene, ValidationErrorsNameFileAndKey) {
   struct Case {
     const char* name;
@@ -73,6 +80,11 @@ TEST(Scene, ValidationErrorsNameFileAndKey) {
          j["material"] = {{"poisson", 0.7}};
        },
        "'material.poisson': 0.7 is outside"},
+      {"bad boolean",
+       [](json& j) {
+         j["solver"] = {{"halve_unresolved", 1}};
+       },
+       "'solver.halve_unresolved': expected true or false"},
       {"bad enum",
        [](json& j) {
          j["output"] = {{"format", "stl"}};

@@ -39,6 +39,9 @@ struct SolverOptions {
   /// or the result is not finite.
   double halve_residual = 1e-2;
   int max_halvings = 3;
+  /// Also halve a substep whose collision response leaves CCD hits unresolved (the impact
+  /// zones gave up): a shorter substep asks of each zone a motion closer to its anchors'.
+  bool halve_unresolved = true;
 };
 
 struct StepStats {
