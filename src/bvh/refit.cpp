@@ -1,5 +1,6 @@
 // Refit: swept boxes and normal cones, level by level from the deepest, each level in parallel.
 
+#include <fmt/format.h>
 #include <tbb/parallel_for.h>
 #include <Eigen/Geometry>
 
@@ -8,6 +9,8 @@
 #include <numbers>
 
 #include "clothcd/bvh/bvh.hpp"
+#include "clothcd/core/error.hpp"
+#include "core/ulp.hpp"
 
 namespace clothcd {
 namespace {
@@ -34,8 +37,8 @@ LeafConePolicy leaf_policy(ConePolicy p) {
 void inflate(BvhNode& n, double margin) {
   if (margin <= 0) return;
   for (int k = 0; k < 3; ++k) {
-    n.lo[k] = std::nextafter(n.lo[k] - margin, -kInf);
-    n.hi[k] = std::nextafter(n.hi[k] + margin, kInf);
+    n.lo[k] = detail::next_down(n.lo[k] - margin);
+    n.hi[k] = detail::next_up(n.hi[k] + margin);
   }
 }
 
@@ -55,7 +58,8 @@ void set_box(BvhNode& n, std::initializer_list<const Eigen::Vector3d*> pts) {
 }  // namespace
 
 template <class LeafFn>
-void Bvh::refit_levels(const RefitOptions& options, LeafFn&& leaf) {
+void Bvh::refit_levels(const RefitOptions& options, std::span<const std::uint8_t> only,
+                       LeafFn&& leaf) {
   const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
   if (optimal) {
     control_dirs_.resize(3 * prim_ids_.size());
@@ -65,6 +69,7 @@ void Bvh::refit_levels(const RefitOptions& options, LeafFn&& leaf) {
     tbb::parallel_for(tbb::blocked_range<int>(level_offsets_[d], level_offsets_[d + 1], 256),
                       [&](const tbb::blocked_range<int>& range) {
                         for (int i = range.begin(); i != range.end(); ++i) {
+                          if (!only.empty() && only[i] == 0) continue;
                           BvhNode& n = nodes_[i];
                           if (n.is_leaf()) {
                             leaf(n, i);
@@ -99,11 +104,44 @@ void Bvh::refit_levels(const RefitOptions& options, LeafFn&& leaf) {
 
 void Bvh::refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
                 const RefitOptions& options) {
+  refit(v_t0, v_t1, options, {});
+}
+
+void Bvh::refit_changed(std::span<const Eigen::Vector3d> v_t0,
+                        std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options) {
+  const std::size_t n = v_t0.size();
+  const bool same = changed_options_ && *changed_options_ == options && changed_t0_.size() == n &&
+                    v_t1.size() == n;
+  if (!same) {
+    refit(v_t0, v_t1, options);
+    changed_t0_.assign(v_t0.begin(), v_t0.end());
+    changed_t1_.assign(v_t1.begin(), v_t1.end());
+    changed_options_ = options;
+    return;
+  }
+  std::vector<std::uint8_t> moved(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (v_t0[i] != changed_t0_[i] || v_t1[i] != changed_t1_[i]) {
+      moved[i] = 1;
+      changed_t0_[i] = v_t0[i];
+      changed_t1_[i] = v_t1[i];
+    }
+  }
+  refit(v_t0, v_t1, options, nodes_holding(topology_->faces_touching(moved)));
+  changed_options_ = options;  // refit() forgot it
+}
+
+void Bvh::refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                const RefitOptions& options, std::span<const std::uint8_t> nodes) {
+  if (!nodes.empty() && nodes.size() != nodes_.size()) {
+    throw InputError(fmt::format("refit: {} node flags for {} nodes", nodes.size(), nodes_.size()));
+  }
+  changed_options_.reset();
   const double margin = 0.5 * options.thickness;
   const LeafConePolicy lp = leaf_policy(options.policy);
   const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
   const auto& faces = topology_->faces();
-  refit_levels(options, [&](BvhNode& n, int i) {
+  refit_levels(options, nodes, [&](BvhNode& n, int i) {
     const Face& t = faces[prim_ids_[n.first]];
     const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
     const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
@@ -128,10 +166,11 @@ void Bvh::refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Ve
 }
 
 void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options) {
+  changed_options_.reset();
   const double margin = 0.5 * options.thickness;
   const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
   const auto& faces = topology_->faces();
-  refit_levels(options, [&](BvhNode& n, int i) {
+  refit_levels(options, {}, [&](BvhNode& n, int i) {
     const Face& t = faces[prim_ids_[n.first]];
     const Eigen::Vector3d &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
     set_box(n, {&a, &b, &c});

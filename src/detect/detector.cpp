@@ -51,8 +51,8 @@ struct SelfDetector::Impl {
   // Active restriction: features on active faces, and the nodes holding a face that touches one.
   bool restricted = false;
   std::vector<std::uint8_t> face_active, vertex_active, edge_active, node_active;
-  // Per-step swept boxes of the features (storage reused across steps).
-  std::vector<detail::Box> vboxes, eboxes, fboxes;
+  // Swept boxes of the features, updated where vertices moved (see FeatureBoxes).
+  detail::FeatureBoxes boxes;
   std::vector<std::pair<int, int>> links;  // opt.linked_vertices, normalized per call
   detail::Ownership owner;
 
@@ -129,7 +129,7 @@ struct SelfDetector::Impl {
     return pairs;
   }
 
-  void narrow(const std::vector<std::pair<int, int>>& pairs, DetectResult& res) {
+  [[nodiscard]] detail::FeatureContext ccd_context() const {
     detail::FeatureContext ctx;
     ctx.topo = &topo;
     ctx.v0 = v0;
@@ -140,7 +140,12 @@ struct SelfDetector::Impl {
     ctx.ccd.toi_tolerance = opt.toi_tolerance;
     ctx.distance_depth = opt.distance_filter_depth;
     ctx.links = links;
-    detail::precompute_boxes(ctx, vboxes, eboxes, fboxes);
+    return ctx;
+  }
+
+  // The feature pairs of `pairs` and of the orphans that collide (ctx's boxes are up to date).
+  void narrow(const detail::FeatureContext& ctx, const std::vector<std::pair<int, int>>& pairs,
+              DetectResult& res) {
     tbb::enumerable_thread_specific<NarrowBuffer> locals;
     auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
     auto kee = [&](int a, int b, NarrowBuffer& out) { ctx.kernel_ee(a, b, out.c, out.ee); };
@@ -236,7 +241,7 @@ struct SelfDetector::Impl {
     ro.thickness = opt.thickness;
     ro.cones = cones_used(opt.culling);
     ro.policy = opt.policy;
-    bvh.refit(v0, v1, ro);
+    bvh.refit_changed(v0, v1, ro);
     st.time_refit = seconds_since(t);
     st.internal_nodes = bvh.num_internal();
     st.connected_internal_nodes = bvh.num_connected_internal();
@@ -246,13 +251,15 @@ struct SelfDetector::Impl {
     const auto pairs = traverse(opt.culling, st);
     st.time_traverse = seconds_since(t);
     t = Clock::now();
-    narrow(pairs, res);
+    detail::FeatureContext ctx = ccd_context();
+    boxes.update(ctx);
+    narrow(ctx, pairs, res);
     st.time_narrow = seconds_since(t);
 
     if (opt.verify && opt.culling != Culling::None) {
       DetectResult ref;
       const auto all = traverse(Culling::None, ref.stats);
-      narrow(all, ref);
+      narrow(ctx, all, ref);
       res.verified = true;
       res.unculled_triangle_pairs = all.size();
       std::set_difference(ref.vf.begin(), ref.vf.end(), res.vf.begin(), res.vf.end(),
@@ -280,7 +287,7 @@ struct SelfDetector::Impl {
     ctx.v0 = v0;
     ctx.v1 = v1;
     ctx.margin = 0.5 * h;
-    detail::precompute_boxes(ctx, vboxes, eboxes, fboxes);
+    boxes.update(ctx);
     struct Buffer {
       std::vector<ProximityResult::VertexFace> vf;
       std::vector<ProximityResult::EdgeEdge> ee;

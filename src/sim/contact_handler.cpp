@@ -636,8 +636,8 @@ struct ContactHandler::Impl {
     RefitOptions ro;
     ro.cones = false;
     ro.thickness = sep;
-    cloth_bvh.refit(x0, x1, ro);
-    if (!body_swept) {  // the body's motion is fixed for the substep: refit once
+    cloth_bvh.refit_changed(x0, x1, ro);  // a later pass redoes the nodes over moved vertices
+    if (!body_swept) {                    // the body's motion is fixed for the substep: refit once
       body_bvh.refit(b0, b1, ro);
       body_swept = true;
     }

@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -61,6 +62,7 @@ struct RefitOptions {
   double thickness = 0.0;  ///< boxes grow by thickness / 2 on every side (rounded outwards)
   bool cones = true;       ///< compute the normal cones (box-only traversal skips them)
   ConePolicy policy = ConePolicy::Proposed;
+  bool operator==(const RefitOptions&) const = default;
 };
 
 class Bvh {
@@ -94,12 +96,25 @@ class Bvh {
   /// Swept boxes of every triangle over the linear motion t0 -> t1 and, optionally, CCD cones.
   void refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
              const RefitOptions& options);
+  /// The same, for the flagged nodes only (one flag per node, as `nodes_holding` gives them:
+  /// every ancestor of a flagged node flagged too); the others keep their last refit's box and
+  /// cone. After a full swept refit with the same options, flagging the nodes that hold every
+  /// face with a moved vertex gives exactly what a full refit would.
+  void refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+             const RefitOptions& options, std::span<const std::uint8_t> nodes);
+  /// The same result as refit(v_t0, v_t1, options), bit for bit; after an earlier call of this
+  /// one with the same options and no other refit since, it redoes only the nodes above faces
+  /// with a vertex whose positions changed. For repeated CCD passes in which a few vertices
+  /// change their motion.
+  void refit_changed(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                     const RefitOptions& options);
   /// Static boxes and skinny (DCD) cones at the positions v.
   void refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options);
 
  private:
   template <class LeafFn>
-  void refit_levels(const RefitOptions& options, LeafFn&& leaf);
+  void refit_levels(const RefitOptions& options, std::span<const std::uint8_t> nodes,
+                    LeafFn&& leaf);
   void compute_flags();
 
   const Topology* topology_ = nullptr;
@@ -113,6 +128,9 @@ class Bvh {
   // Unit Bernstein control directions of each leaf, by prim position (Optimal policy only).
   std::vector<Eigen::Vector3d> control_dirs_;
   std::vector<std::uint8_t> degenerate_;
+  // What the last refit_changed() fitted (unset after any other refit).
+  std::optional<RefitOptions> changed_options_;
+  std::vector<Eigen::Vector3d> changed_t0_, changed_t1_;
 };
 
 }  // namespace clothcd
