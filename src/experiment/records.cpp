@@ -219,8 +219,10 @@ std::string step_rows_csv(const std::vector<StepRow>& rows) {
   out += ",ms_cd,ms_total\n";
   for (const auto& r : rows) {
     out += fmt::format("{},{},{},{},{}", r.scene, r.step, r.build, r.culling, r.policy);
-    for (const auto& c : kStepCols)
-      out += "," + num(r.*c.member);
+    for (const auto& c : kStepCols) {
+      out += ',';
+      out += num(r.*c.member);
+    }
     out += fmt::format(",{},{}\n", num(r.ms_cd()), num(r.ms_total()));
   }
   return out;

@@ -194,11 +194,9 @@ std::string table1(const std::vector<SceneData>& data, const ExperimentOptions& 
       for (const auto& [c, p] : cols) {
         const auto it = d.agg.find({build_name(b), culling_name(c), policy_name(p)});
         const auto base = d.agg.find({build_name(b), culling_name(c), "PROVOT"});
-        s += " " +
-             (it != d.agg.end() && base != d.agg.end()
-                  ? pct(reduction(mean(it->second.pairs), mean(base->second.pairs)))
-                  : std::string("-")) +
-             " |";
+        const bool both = it != d.agg.end() && base != d.agg.end();
+        s += fmt::format(
+            " {} |", both ? pct(reduction(mean(it->second.pairs), mean(base->second.pairs))) : "-");
       }
       s += "\n";
     }

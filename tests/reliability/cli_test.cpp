@@ -145,7 +145,8 @@ TEST(CliDeterminism, DetectSameForOneTwoAndFourThreads) {
   std::vector<nlohmann::json> results;
   for (int threads : {1, 2, 4}) {
     for (const char* culling : {"none", "sound"}) {
-      const std::string out = "t" + std::to_string(threads) + culling + ".json";
+      const std::string out =
+          std::string("t").append(std::to_string(threads)).append(culling) + ".json";
       const auto r = dir.run("detect --t0 t0.obj --t1 t1.obj --culling " + std::string(culling) +
                              " --threads " + std::to_string(threads) + " --json " + out);
       ASSERT_EQ(r.code, 0) << r.err;
@@ -169,7 +170,7 @@ TEST(CliCcdQueries, MalformedCsvWithJson) {
     good += "0,1," + std::to_string(k) + ",1,1,2,0\n";
   dir.write("q/vertex-face/a.csv", good);
   std::string bad = good;
-  bad.replace(bad.find("\n") + 1 + 2, 1, "x");  // line 2, column 2
+  bad[bad.find('\n') + 1 + 2] = 'x';  // line 2, column 2
   dir.write("q/vertex-face/b.csv", bad);
   const auto r = dir.run("ccd-queries q --json out.json");
   EXPECT_EQ(r.code, 2) << r.err;
