@@ -1,6 +1,5 @@
 // Refit: swept boxes and normal cones, level by level from the deepest, each level in parallel.
 
-#include <fmt/format.h>
 #include <tbb/parallel_for.h>
 #include <Eigen/Geometry>
 
@@ -9,7 +8,7 @@
 #include <numbers>
 
 #include "clothcd/bvh/bvh.hpp"
-#include "clothcd/core/error.hpp"
+#include "core/moved_vertices.hpp"
 #include "core/ulp.hpp"
 
 namespace clothcd {
@@ -102,41 +101,30 @@ void Bvh::refit_levels(const RefitOptions& options, std::span<const std::uint8_t
   }
 }
 
+void Bvh::forget_changes() {
+  changed_options_.reset();
+  changed_t0_.clear();
+  changed_t1_.clear();
+}
+
 void Bvh::refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
                 const RefitOptions& options) {
-  refit(v_t0, v_t1, options, {});
+  forget_changes();
+  refit_nodes(v_t0, v_t1, options, {});
 }
 
 void Bvh::refit_changed(std::span<const Eigen::Vector3d> v_t0,
                         std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options) {
-  const std::size_t n = v_t0.size();
-  const bool same = changed_options_ && *changed_options_ == options && changed_t0_.size() == n &&
-                    v_t1.size() == n;
-  if (!same) {
-    refit(v_t0, v_t1, options);
-    changed_t0_.assign(v_t0.begin(), v_t0.end());
-    changed_t1_.assign(v_t1.begin(), v_t1.end());
-    changed_options_ = options;
-    return;
-  }
-  std::vector<std::uint8_t> moved(n, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (v_t0[i] != changed_t0_[i] || v_t1[i] != changed_t1_[i]) {
-      moved[i] = 1;
-      changed_t0_[i] = v_t0[i];
-      changed_t1_[i] = v_t1[i];
-    }
-  }
-  refit(v_t0, v_t1, options, nodes_holding(topology_->faces_touching(moved)));
-  changed_options_ = options;  // refit() forgot it
+  if (changed_options_ != options) forget_changes();
+  const auto moved = detail::moved_vertices(changed_t0_, changed_t1_, v_t0, v_t1);
+  refit_nodes(
+      v_t0, v_t1, options,
+      moved ? nodes_holding(topology_->faces_touching(*moved)) : std::vector<std::uint8_t>{});
+  changed_options_ = options;
 }
 
-void Bvh::refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
-                const RefitOptions& options, std::span<const std::uint8_t> nodes) {
-  if (!nodes.empty() && nodes.size() != nodes_.size()) {
-    throw InputError(fmt::format("refit: {} node flags for {} nodes", nodes.size(), nodes_.size()));
-  }
-  changed_options_.reset();
+void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                      const RefitOptions& options, std::span<const std::uint8_t> nodes) {
   const double margin = 0.5 * options.thickness;
   const LeafConePolicy lp = leaf_policy(options.policy);
   const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
@@ -166,7 +154,7 @@ void Bvh::refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Ve
 }
 
 void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options) {
-  changed_options_.reset();
+  forget_changes();
   const double margin = 0.5 * options.thickness;
   const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
   const auto& faces = topology_->faces();

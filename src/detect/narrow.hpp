@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -18,6 +19,7 @@
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/types.hpp"
+#include "core/moved_vertices.hpp"
 #include "core/ulp.hpp"
 
 namespace clothcd::detail {
@@ -195,39 +197,31 @@ class FeatureBoxes {
   void update(FeatureContext& ctx) {
     const Topology& topo = *ctx.topo;
     const int nv = topo.num_vertices();
-    std::vector<std::uint8_t> changed;
-    const bool full = !(x0_.size() == static_cast<std::size_t>(nv) && margin_ == ctx.margin);
-    if (full) {
+    if (margin_ != ctx.margin) {  // every box changes: start over
+      x0_.clear();
+      margin_ = ctx.margin;
+    }
+    const auto moved = moved_vertices(x0_, x1_, ctx.v0, ctx.v1);
+    if (!moved) {
       vboxes_.resize(nv);
       eboxes_.resize(topo.num_edges());
       fboxes_.resize(topo.num_faces());
-      x0_.assign(ctx.v0.begin(), ctx.v0.end());
-      x1_.assign(ctx.v1.begin(), ctx.v1.end());
-      margin_ = ctx.margin;
-    } else {
-      changed.assign(nv, 0);
-      for_each(nv, [&](int i) {
-        if (x0_[i] != ctx.v0[i] || x1_[i] != ctx.v1[i]) {
-          changed[i] = 1;
-          x0_[i] = ctx.v0[i];
-          x1_[i] = ctx.v1[i];
-        }
-      });
     }
-    const auto any = [&](auto&& ids) {
+    const auto redo = [&](auto&& ids) {  // a vertex of the feature moved (or all did)
+      if (!moved) return true;
       for (int v : ids) {
-        if (changed[v]) return true;
+        if ((*moved)[v]) return true;
       }
       return false;
     };
     for_each(nv, [&](int i) {
-      if (full || changed[i]) vboxes_[i] = ctx.compute_vertex_box(i);
+      if (redo(std::array<int, 1>{i})) vboxes_[i] = ctx.compute_vertex_box(i);
     });
     for_each(topo.num_edges(), [&](int e) {
-      if (full || any(topo.edges()[e])) eboxes_[e] = ctx.compute_edge_box(e);
+      if (redo(topo.edges()[e])) eboxes_[e] = ctx.compute_edge_box(e);
     });
     for_each(topo.num_faces(), [&](int f) {
-      if (full || any(topo.faces()[f])) fboxes_[f] = ctx.compute_face_box(f);
+      if (redo(topo.faces()[f])) fboxes_[f] = ctx.compute_face_box(f);
     });
     ctx.vboxes = vboxes_;
     ctx.eboxes = eboxes_;

@@ -96,12 +96,6 @@ class Bvh {
   /// Swept boxes of every triangle over the linear motion t0 -> t1 and, optionally, CCD cones.
   void refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
              const RefitOptions& options);
-  /// The same, for the flagged nodes only (one flag per node, as `nodes_holding` gives them:
-  /// every ancestor of a flagged node flagged too); the others keep their last refit's box and
-  /// cone. After a full swept refit with the same options, flagging the nodes that hold every
-  /// face with a moved vertex gives exactly what a full refit would.
-  void refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
-             const RefitOptions& options, std::span<const std::uint8_t> nodes);
   /// The same result as refit(v_t0, v_t1, options), bit for bit; after an earlier call of this
   /// one with the same options and no other refit since, it redoes only the nodes above faces
   /// with a vertex whose positions changed. For repeated CCD passes in which a few vertices
@@ -115,6 +109,11 @@ class Bvh {
   template <class LeafFn>
   void refit_levels(const RefitOptions& options, std::span<const std::uint8_t> nodes,
                     LeafFn&& leaf);
+  // refit(v_t0, v_t1, options) of the flagged nodes only (all when `nodes` is empty; flags as
+  // nodes_holding gives them); the others keep their last refit's box and cone.
+  void refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                   const RefitOptions& options, std::span<const std::uint8_t> nodes);
+  void forget_changes();
   void compute_flags();
 
   const Topology* topology_ = nullptr;
@@ -128,7 +127,7 @@ class Bvh {
   // Unit Bernstein control directions of each leaf, by prim position (Optimal policy only).
   std::vector<Eigen::Vector3d> control_dirs_;
   std::vector<std::uint8_t> degenerate_;
-  // What the last refit_changed() fitted (unset after any other refit).
+  // What the last refit_changed() fitted (cleared by any other refit).
   std::optional<RefitOptions> changed_options_;
   std::vector<Eigen::Vector3d> changed_t0_, changed_t1_;
 };
