@@ -114,6 +114,8 @@ constexpr int kFilterDepth = 6;
 // which a sweep counts as converged.
 constexpr int kProjectionSweeps = 100;
 constexpr double kProjectionTolerance = 0.01;
+// Smallest weight at which a contact's cloth vertex gets its own repulsion (repel_pointwise()).
+constexpr double kPointwiseWeight = 0.05;
 // Zone rounds that still demand the CCD margin; later ones demand only no contact.
 constexpr int kMarginRounds = 5;
 
@@ -126,6 +128,8 @@ struct ContactHandler::Impl {
   std::optional<Topology> body_topo;
   Bvh cloth_bvh, body_bvh;
   std::vector<Contact> proximity;
+  std::vector<ContactConstraint> constraints;  // see add_constraint()
+  double constraint_gap = 0.0;
   // This substep's CCD impacts so far and their accumulated impulses (see project()).
   std::vector<Contact> impacts;
   std::vector<double> lambda;
@@ -198,6 +202,59 @@ struct ContactHandler::Impl {
       if (!c.on_body[k]) v[c.id[k]] += (c.c[k] * j * weight(c, k)) * dir;
     }
     return true;
+  }
+
+  // Repulsion point by point: every cloth vertex of one side (weight >= kPointwiseWeight) keeps
+  // the other side's cloth vertices, or its body point, from approaching faster than the
+  // contact's target; the weighted sum of these is the contact's own condition, which the
+  // caller then tops up for the light-weight vertices left out. Why: the contact's single
+  // impulse, spread by weight over inverse mass, gives the vertex nearest the contact point a
+  // velocity change larger than the contact's deficit. A collar vertex already stopped by its own
+  // body contact was thrown off the shoulder at 0.73 m/s because its face's other two vertices
+  // still fell onto a body vertex; the membrane pulled it back, and the collar shook at up to
+  // 5 m/s (multilayer-rumba frames 1-3, docs/simulator.md). Returns whether an impulse was applied.
+  bool repel_pointwise(const Contact& c, double target, bool friction, std::span<Vec3> v) const {
+    // Side 0: c_k > 0; side 1: c_k < 0. A body side acts as one point: its weighted velocity.
+    std::array<std::array<int, 4>, 2> pts{};
+    std::array<int, 2> count{};
+    std::array<Vec3, 2> body_v{Vec3::Zero(), Vec3::Zero()};
+    std::array<bool, 2> body{false, false};
+    for (int k = 0; k < 4; ++k) {
+      if (c.c[k] == 0.0) continue;
+      const int side = c.c[k] > 0 ? 0 : 1;
+      if (c.on_body[k]) {
+        body[side] = true;
+        body_v[side] += std::abs(c.c[k]) * vb[c.id[k]];
+      } else if (std::abs(c.c[k]) >= kPointwiseWeight && inv_mass[c.id[k]] > 0) {
+        pts[side][count[side]++] = c.id[k];
+      }
+    }
+    if (body[0]) count[0] = 1;
+    if (body[1]) count[1] = 1;
+    bool any = false;
+    for (int a = 0; a < count[0]; ++a) {
+      for (int b = 0; b < count[1]; ++b) {
+        const int i = body[0] ? -1 : pts[0][a];
+        const int j = body[1] ? -1 : pts[1][b];
+        const double wi = i < 0 ? 0.0 : inv_mass[i];
+        const double wj = j < 0 ? 0.0 : inv_mass[j];
+        if (!(wi + wj > 0)) continue;
+        const Vec3 rel = (i < 0 ? body_v[0] : v[i]) - (j < 0 ? body_v[1] : v[j]);
+        const double vn = c.n.dot(rel);
+        if (vn >= target) continue;
+        const double dn = target - vn;
+        Vec3 d = (dn / (wi + wj)) * c.n;  // impulse
+        if (friction) {
+          const Vec3 vt = rel - vn * c.n;
+          const double lt = vt.norm();
+          if (lt > 0) d -= (std::min(opt.friction * dn, lt) / (wi + wj) / lt) * vt;
+        }
+        if (i >= 0) v[i] += wi * d;
+        if (j >= 0) v[j] -= wj * d;
+        any = true;
+      }
+    }
+    return any;
   }
 
   // Orients n so that the contact's start gap is >= 0; false for a degenerate normal.
@@ -401,6 +458,7 @@ struct ContactHandler::Impl {
     inv_mass = ctx.inverse_mass;
     x0m = to_matrix(x0);
     proximity.clear();
+    constraints.clear();
     excluded = 0;
     body_swept = false;
     if (has_body(ctx)) ensure_body(ctx);  // the crossing counter and the body queries need it
@@ -507,6 +565,7 @@ struct ContactHandler::Impl {
         Contact c;
         if (k_cb[i] && make_vf(c, vf_cb[i].first, false, vf_cb[i].second, true, 0.0, none)) {
           proximity.push_back(c);
+          if (opt.body_constraints) add_constraint(c);
         }
       }
       for (std::size_t i = 0; i < vf_bc.size(); ++i) {
@@ -522,6 +581,27 @@ struct ContactHandler::Impl {
         }
       }
     }
+  }
+
+  // Keeps, per cloth vertex, the constraint of its nearest body face (contacts come sorted by
+  // vertex). The body point's normal velocity over the substep plus the repulsion target.
+  void add_constraint(const Contact& c) {
+    const int v = c.id[0];
+    if (!(inv_mass[v] > 0)) return;
+    Vec3 vb_point = Vec3::Zero();
+    for (int k = 1; k < 4; ++k)
+      vb_point -= c.c[k] * (b1[c.id[k]] - b0[c.id[k]]) / h;
+    const double target = opt.repulsion_fraction * (opt.thickness - c.gap) / h;
+    const ContactConstraint cc{v, c.n, c.n.dot(vb_point) + target};
+    if (!constraints.empty() && constraints.back().vertex == v) {
+      if (c.gap < constraint_gap) {
+        constraints.back() = cc;
+        constraint_gap = c.gap;
+      }
+      return;
+    }
+    constraints.push_back(cc);
+    constraint_gap = c.gap;
   }
 
   // What becomes of one self-CCD hit of the detector.
@@ -834,13 +914,15 @@ struct ContactHandler::Impl {
       bool any = false;
       for (const Contact& c : proximity) {
         const double target = opt.repulsion_fraction * (opt.thickness - c.gap) / h;
+        const bool friction = sweep == 0 && opt.friction > 0;
+        if (opt.pointwise_repulsion && repel_pointwise(c, target, friction, v)) any = true;
         const Vec3 rel = relative_velocity(c, v);
         const double vn = c.n.dot(rel);
         if (vn >= target) continue;
         const double dn = target - vn;
         if (!impulse(c, c.n, dn, v)) continue;
         any = true;
-        if (sweep > 0 || !(opt.friction > 0)) continue;
+        if (!friction) continue;
         const Vec3 vt = rel - vn * c.n;
         const double lt = vt.norm();
         if (lt > 0) impulse(c, -vt / lt, std::min(opt.friction * dn, lt), v);
@@ -1081,6 +1163,10 @@ ContactHandler::~ContactHandler() = default;
 
 void ContactHandler::prepare(const SubstepContext& ctx) {
   impl_->prepare(ctx);
+}
+
+void ContactHandler::contact_constraints(std::vector<ContactConstraint>& out) const {
+  out = impl_->constraints;
 }
 
 CollisionStats ContactHandler::respond(const SubstepContext& ctx, std::span<Vec3> v_star) {

@@ -300,6 +300,8 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                              {"zone_rounds", c.zone_rounds},
                              {"repulsion_fraction", c.repulsion_fraction},
                              {"repulsion_sweeps", c.repulsion_sweeps},
+                             {"pointwise_repulsion", c.pointwise_repulsion},
+                             {"body_constraints", c.body_constraints},
                              {"untangle_step", c.untangle_step},
                              {"zone_motion", c.affine_zones ? "affine" : "rigid"},
                              {"friction", c.friction}};

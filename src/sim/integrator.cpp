@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <vector>
 
 #include "clothcd/core/error.hpp"
 #include "pcg.hpp"
@@ -42,6 +43,7 @@ struct ClothSolver::Impl {
   VertexFilter filter;
   std::vector<double> inverse_mass;
   std::vector<Vec3> body_t0, body_t1;
+  std::vector<ContactConstraint> constraints;
 
   Vec3 pin_target(const PinnedVertex& p, double t) const {
     const PinGroup& g = groups[p.group];
@@ -121,17 +123,70 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
   const Vec3 g = options_.gravity;
   for_each_vertex(
       n, [&](int i) { im.b[i] = h * (mass[i] * g - im.gradient[i] - (h + beta) * im.hv[i]); });
-  // Start: prescribed changes on pinned vertices, the previous change elsewhere (warm start).
+  // Contact constraints of this substep constrain one direction of free vertices; the filter is
+  // restored however this attempt ends.
+  im.constraints.clear();
+  if (handler_ != nullptr) handler_->contact_constraints(im.constraints);
+  // A handler's constraint on no vertex or along no direction is ignored, not trusted.
+  std::erase_if(im.constraints, [n](ContactConstraint& c) {
+    const double len = c.n.norm();
+    if (c.vertex < 0 || c.vertex >= n || !(len > 0.0) || !std::isfinite(len) ||
+        !std::isfinite(c.normal_velocity))
+      return true;
+    c.n /= len;
+    return false;
+  });
+  struct RestoreFilter {
+    Impl& im;
+    ~RestoreFilter() {
+      for (const ContactConstraint& c : im.constraints) {
+        if (im.filter.kind[c.vertex] == VertexFilter::Plane)
+          im.filter.kind[c.vertex] = VertexFilter::Free;
+      }
+    }
+  } restore{im};
+  for (const ContactConstraint& c : im.constraints) {
+    if (im.filter.kind[c.vertex] != VertexFilter::Free) continue;
+    im.filter.kind[c.vertex] = VertexFilter::Plane;
+    im.filter.direction[c.vertex] = c.n;
+  }
+  // Start: prescribed changes on pinned vertices and along constrained directions, the previous
+  // change elsewhere (warm start).
   Vecs dv(n);
   for_each_vertex(n, [&](int i) { dv[i] = im.filter.apply(i, state.dv[i]); });
   for (const PinnedVertex& p : im.pinned) {
     dv[p.vertex] = (im.pin_target(p, state.time + h) - state.x[p.vertex]) / h - state.v[p.vertex];
   }
+  for (const ContactConstraint& c : im.constraints) {
+    if (im.filter.kind[c.vertex] == VertexFilter::Plane)
+      dv[c.vertex] += c.n * (c.normal_velocity - c.n.dot(state.v[c.vertex]));
+  }
   const PcgOptions pcg{options_.pcg_max_iterations, options_.pcg_tolerance};
-  const PcgResult res = solve_pcg(im.h, h * (h + beta), mass, im.b, im.filter, pcg, dv);
+  PcgResult res = solve_pcg(im.h, h * (h + beta), mass, im.b, im.filter, pcg, dv);
   ++stats.solves;
   stats.pcg_iterations += res.iterations;
   stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);
+  // A constraint whose force would pull its vertex onto the body is let go, and the solve redone
+  // from where it stopped (Baraff & Witkin 1998 release the next step; here the same one).
+  if (!im.constraints.empty() && std::isfinite(res.relative_residual)) {
+    Vecs q(n);
+    multiply(im.h, dv, q);
+    bool released = false;
+    for (const ContactConstraint& c : im.constraints) {
+      const int i = c.vertex;
+      if (im.filter.kind[i] != VertexFilter::Plane) continue;
+      const Vec3 r = im.b[i] - (mass[i] * dv[i] + h * (h + beta) * q[i]);
+      if (c.n.dot(r) > 0.0) {
+        im.filter.kind[i] = VertexFilter::Free;
+        released = true;
+      }
+    }
+    if (released) {
+      res = solve_pcg(im.h, h * (h + beta), mass, im.b, im.filter, pcg, dv);
+      stats.pcg_iterations += res.iterations;
+      stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);
+    }
+  }
   bool finite = std::isfinite(res.relative_residual);
   for (int i = 0; i < n && finite; ++i)
     finite = dv[i].allFinite();

@@ -426,6 +426,8 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     c.zone_rounds = o.integer("zone_rounds", c.zone_rounds, 0, 10000);
     c.repulsion_fraction = o.number("repulsion_fraction", c.repulsion_fraction, 0.0, 1.0);
     c.repulsion_sweeps = o.integer("repulsion_sweeps", c.repulsion_sweeps, 1, 1000);
+    c.pointwise_repulsion = o.boolean("pointwise_repulsion", c.pointwise_repulsion);
+    c.body_constraints = o.boolean("body_constraints", c.body_constraints);
     c.full_passes = o.boolean("full_passes", c.full_passes);
     c.untangle_step = o.number("untangle_step", c.untangle_step, 0.0, 1.0);
     c.affine_zones = o.string("zone_motion", c.affine_zones ? "affine" : "rigid",

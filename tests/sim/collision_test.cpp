@@ -129,6 +129,93 @@ TEST(ContactHandler, BodyHasInfiniteMass) {
   EXPECT_TRUE(c.body_pairs(s.x1, body1).empty());
 }
 
+// A cloth triangle resting 0.5 mm above a body triangle that rises at 0.1 m/s.
+struct RestingOnRisingBody {
+  ClothModel cloth;
+  std::vector<Vec3> body0 = {{-1, 0, -1}, {2, 0, -1}, {-1, 0, 2}};
+  std::vector<Vec3> body1;
+  std::vector<Face> body_faces = {{0, 2, 1}};
+  std::vector<double> inv;
+  double h = 0.01;
+  RestingOnRisingBody() : cloth(one_triangle(0.0005), ClothMaterial{}) {
+    body1 = body0;
+    for (Vec3& b : body1)
+      b.y() += 0.1 * h;
+    for (double m : cloth.mass())
+      inv.push_back(1.0 / m);
+  }
+  static ClothMeshInput one_triangle(double y) {
+    ClothMeshInput in;
+    in.positions = {{0.2, y, 0.2}, {0.6, y, 0.2}, {0.2, y, 0.6}};
+    in.faces = {{0, 2, 1}};
+    return in;
+  }
+  [[nodiscard]] std::vector<ContactConstraint> constraints(const ContactOptions& o) const {
+    SubstepContext ctx;
+    ctx.h = h;
+    ctx.x0 = cloth.initial_positions();
+    ctx.inverse_mass = inv;
+    ctx.cloth = &cloth.topology();
+    ctx.body_t0 = body0;
+    ctx.body_t1 = body1;
+    ctx.body_faces = &body_faces;
+    ContactHandler handler(cloth, o);
+    handler.prepare(ctx);
+    std::vector<ContactConstraint> out;
+    handler.contact_constraints(out);
+    return out;
+  }
+};
+
+TEST(ContactHandler, ClothVerticesOnTheBodyBecomeConstraintsOfTheSolve) {
+  const RestingOnRisingBody s;
+  ContactOptions o;
+  const std::vector<ContactConstraint> c = s.constraints(o);
+  ASSERT_EQ(c.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(c[i].vertex, i);
+    EXPECT_NEAR((c[i].n - Vec3(0, 1, 0)).norm(), 0.0, 1e-12);
+    // The body's normal velocity plus the repulsion target 0.1 (1 mm - 0.5 mm) / h.
+    EXPECT_NEAR(c[i].normal_velocity, 0.1 + 0.1 * 0.0005 / s.h, 1e-9);
+  }
+  o.body_constraints = false;
+  EXPECT_TRUE(s.constraints(o).empty());
+}
+
+// A cloth triangle falling at 1 m/s: vertex 0 rests 0.5 mm above a small body plate, and a body
+// spike stands 0.5 mm under the face near vertex 0, while vertices 1 and 2 are far from the body.
+struct FaceOnSpike {
+  ClothModel cloth;
+  std::vector<Vec3> body = {{-0.01, 0.0095, -0.01}, {0.01, 0.0095, -0.01}, {-0.01, 0.0095, 0.01},
+                            {0.02, 0.0095, 0.02},   {0.03, -0.05, 0.02},   {0.02, -0.05, 0.03}};
+  std::vector<Face> body_faces = {{0, 2, 1}, {3, 5, 4}};
+  FaceOnSpike() : cloth(triangle(), ClothMaterial{}) {}
+  static ClothMeshInput triangle() {
+    ClothMeshInput in;
+    in.positions = {{0, 0.01, 0}, {0.1, 0.01, 0}, {0, 0.01, 0.1}};
+    in.faces = {{0, 2, 1}};
+    return in;
+  }
+};
+
+TEST(ContactHandler, RepulsionDoesNotThrowARestingVertexOffTheBody) {
+  const FaceOnSpike s;
+  const std::vector<Vec3> v(3, Vec3(0, -1.0, 0));
+  ContactOptions o;
+  o.body_constraints = false;  // the response alone
+  const OneStep pw = one_step(s.cloth, v, 0.005, s.body, &s.body_faces, {}, o);
+  EXPECT_GT(pw.stats.proximity_pairs, 0);
+  // Every vertex stops falling onto the body and none leaves it faster than repulsion asks.
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_GE(pw.v[i].y(), -1e-9) << i;
+    EXPECT_LT(pw.v[i].y(), 0.05) << i;
+  }
+  // One impulse per contact, spread by weight, throws vertex 0 (weight 0.6 at the spike) up.
+  o.pointwise_repulsion = false;
+  const OneStep one = one_step(s.cloth, v, 0.005, s.body, &s.body_faces, {}, o);
+  EXPECT_GT(one.v[0].y(), 0.2);
+}
+
 TEST(ContactHandler, RestingPairInsideTheSeparationIsNotAHit) {
   // 5 um apart (inside the 10 um CCD separation), sliding together: the pair never approaches,
   // so it is not a CCD hit (it used to be one at toi 0 in every pass and zone round).

@@ -274,5 +274,80 @@ TEST(Integrator, UnresolvedHitsAreAcceptedAtTheLastHalvingOrWhenHalvingIsOff) {
   }
 }
 
+// A handler that asks the solve to keep fixed contact constraints and changes nothing after it.
+class FixedConstraints : public CollisionHandler {
+ public:
+  explicit FixedConstraints(std::vector<ContactConstraint> c) : c_(std::move(c)) {}
+  void prepare(const SubstepContext&) override {}
+  void contact_constraints(std::vector<ContactConstraint>& out) const override { out = c_; }
+  CollisionStats respond(const SubstepContext&, std::span<Vec3>) override { return {}; }
+
+ private:
+  std::vector<ContactConstraint> c_;
+};
+
+TEST(Integrator, ContactConstraintHoldsItsVertexAndThroughItTheClothAroundIt) {
+  // A horizontal cloth under gravity resting on one point in its middle (vertex 12 of 5 x 5).
+  const ClothModel m(grid_cloth(4, 4, 0.04, 0.04, 1.0), ClothMaterial{});
+  SolverOptions opt;
+  opt.pcg_tolerance = 1e-12;
+  const double h = 0.002;
+  ClothSolver free(m, opt);
+  ClothState f = free.initial_state();
+  free.step(f, h);
+  ClothSolver held(m, opt);
+  FixedConstraints handler({{12, Vec3(0, 1, 0), 0.01}});
+  held.set_collision_handler(&handler);
+  ClothState s = held.initial_state();
+  held.step(s, h);
+  EXPECT_NEAR(s.v[12].y(), 0.01, 1e-12);  // the prescribed normal velocity, exactly
+  EXPECT_NEAR(s.v[12].x(), 0.0, 1e-12);
+  EXPECT_NEAR(s.v[12].z(), 0.0, 1e-12);
+  // Its neighbours fall slower than the free cloth, which falls as one piece.
+  for (int i : {7, 11, 13, 17}) {
+    EXPECT_NEAR(f.v[i].y(), -9.81 * h, 1e-9);
+    EXPECT_GT(s.v[i].y(), f.v[i].y() + 1e-3) << i;
+  }
+}
+
+TEST(Integrator, ContactConstraintThatWouldPullItsVertexIsLetGo) {
+  // The contact is above the cloth (normal pointing down) and gravity pulls the cloth away from
+  // it: holding the vertex would be adhesion, so the step is the free one.
+  const ClothModel m(grid_cloth(4, 4, 0.04, 0.04, 1.0), ClothMaterial{});
+  SolverOptions opt;
+  opt.pcg_tolerance = 1e-12;
+  const double h = 0.002;
+  ClothSolver free(m, opt);
+  ClothState f = free.initial_state();
+  free.step(f, h);
+  ClothSolver held(m, opt);
+  FixedConstraints handler({{12, Vec3(0, -1, 0), 0.0}});
+  held.set_collision_handler(&handler);
+  ClothState s = held.initial_state();
+  const StepStats st = held.step(s, h);
+  for (int i = 0; i < m.num_vertices(); ++i)
+    EXPECT_LE((s.v[i] - f.v[i]).norm(), 1e-9) << i;
+  EXPECT_EQ(st.solves, 1);  // a released constraint re-solves within the same attempt
+}
+
+TEST(Integrator, ContactConstraintsOnNoVertexOrAlongNoDirectionAreIgnored) {
+  const ClothModel m(grid_cloth(2, 2, 0.04, 0.04, 1.0), ClothMaterial{});
+  SolverOptions opt;
+  opt.pcg_tolerance = 1e-12;
+  ClothSolver free(m, opt);
+  ClothState f = free.initial_state();
+  free.step(f, 0.002);
+  ClothSolver held(m, opt);
+  FixedConstraints handler({{-1, Vec3(0, 1, 0), 0.0},
+                            {m.num_vertices(), Vec3(0, 1, 0), 0.0},
+                            {4, Vec3::Zero(), 0.0},
+                            {4, Vec3(0, 1, 0), NAN}});
+  held.set_collision_handler(&handler);
+  ClothState s = held.initial_state();
+  held.step(s, 0.002);
+  for (int i = 0; i < m.num_vertices(); ++i)
+    EXPECT_EQ(s.v[i], f.v[i]) << i;
+}
+
 }  // namespace
 }  // namespace clothcd::sim

@@ -58,6 +58,17 @@ TEST(Scene, UnresolvedHitsHalveTheSubstepUnlessTheSceneSaysNot) {
   EXPECT_FALSE(parse_scene(j, "test-scene.json").solver.halve_unresolved);
 }
 
+TEST(Scene, RepulsionIsPointwiseAndBodyContactsConstrainTheSolveUnlessTheSceneSaysNot) {
+  json j = small_grid_scene();
+  const Scene on = parse_scene(j, "test-scene.json");
+  EXPECT_TRUE(on.contact.pointwise_repulsion);
+  EXPECT_TRUE(on.contact.body_constraints);
+  j["collisions"] = {{"pointwise_repulsion", false}, {"body_constraints", false}};
+  const Scene off = parse_scene(j, "test-scene.json");
+  EXPECT_FALSE(off.contact.pointwise_repulsion);
+  EXPECT_FALSE(off.contact.body_constraints);
+}
+
 TEST(Scene, ValidationErrorsNameFileAndKey) {
   struct Case {
     const char* name;
@@ -85,6 +96,11 @@ TEST(Scene, ValidationErrorsNameFileAndKey) {
          j["solver"] = {{"halve_unresolved", 1}};
        },
        "'solver.halve_unresolved': expected true or false"},
+      {"bad contact boolean",
+       [](json& j) {
+         j["collisions"] = {{"body_constraints", "yes"}};
+       },
+       "'collisions.body_constraints': expected true or false"},
       {"bad enum",
        [](json& j) {
          j["output"] = {{"format", "stl"}};

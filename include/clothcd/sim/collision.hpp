@@ -38,11 +38,23 @@ struct CollisionStats {
   double seconds = 0.0;
 };
 
+/// A cloth vertex resting on the body at the substep start: the dynamics solve moves it along
+/// `n` (unit, away from the body) at exactly `normal_velocity`, so the cloth it holds up is
+/// held up within the same solve (Baraff & Witkin 1998), instead of falling on while only the
+/// vertex in contact is stopped afterwards.
+struct ContactConstraint {
+  int vertex = -1;
+  Vec3 n = Vec3::Zero();
+  double normal_velocity = 0.0;
+};
+
 class CollisionHandler {
  public:
   virtual ~CollisionHandler() = default;
   /// Before the dynamics solve.
   virtual void prepare(const SubstepContext& ctx) = 0;
+  /// After prepare: the constraints the dynamics solve should keep (default: none).
+  virtual void contact_constraints(std::vector<ContactConstraint>& out) const { out.clear(); }
   /// After it: adjust v* in place.
   virtual CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v_star) = 0;
 };

@@ -30,6 +30,15 @@ struct ContactOptions {
   /// Gauss-Seidel sweeps of the repulsion impulses (the first one also applies friction). On
   /// multilayer-kick frames 1-3, 20 instead of 1 left 31,521 instead of 154,054 CCD hits.
   int repulsion_sweeps = 20;
+  /// Repulsion keeps each cloth vertex of a contact (weight >= 0.05) from approaching the other
+  /// side, then tops up the contact as a whole; false: the contact's single impulse spread by
+  /// weight, which threw light vertices off resting contacts (docs/simulator.md 3.1).
+  bool pointwise_repulsion = true;
+  /// Cloth vertices within `thickness` of a body face at the substep start are held to the
+  /// body's normal velocity (plus the repulsion target) inside the dynamics solve, and let go
+  /// when that would hold them down (docs/simulator.md 3.1); false: only the response after the
+  /// solve stops them.
+  bool body_constraints = true;
   /// Every CCD pass and zone round tests every pair (diagnostic). By default, passes after the
   /// first test only pairs with a vertex whose velocity the last response changed or that was in
   /// the last pass's hits: every other pair keeps a motion already tested without a hit, so
@@ -55,6 +64,7 @@ class ContactHandler final : public CollisionHandler {
   ~ContactHandler() override;
 
   void prepare(const SubstepContext& ctx) override;
+  void contact_constraints(std::vector<ContactConstraint>& out) const override;
   CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v_star) override;
 
   [[nodiscard]] const ContactOptions& options() const { return options_; }
