@@ -123,33 +123,29 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
   const Vec3 g = options_.gravity;
   for_each_vertex(
       n, [&](int i) { im.b[i] = h * (mass[i] * g - im.gradient[i] - (h + beta) * im.hv[i]); });
-  // Contact constraints of this substep constrain one direction of free vertices; the filter is
+  // Contact constraints constrain one direction of free vertices, the first constraint of a
+  // vertex only; one on no vertex or along no direction is ignored, not trusted. The filter is
   // restored however this attempt ends.
+  std::vector<ContactConstraint> asked;
+  if (handler_ != nullptr) handler_->contact_constraints(asked);
   im.constraints.clear();
-  if (handler_ != nullptr) handler_->contact_constraints(im.constraints);
-  // A handler's constraint on no vertex or along no direction is ignored, not trusted.
-  std::erase_if(im.constraints, [n](ContactConstraint& c) {
+  for (ContactConstraint c : asked) {
     const double len = c.n.norm();
     if (c.vertex < 0 || c.vertex >= n || !(len > 0.0) || !std::isfinite(len) ||
-        !std::isfinite(c.normal_velocity))
-      return true;
-    c.n /= len;
-    return false;
-  });
+        !std::isfinite(c.normal_velocity) || im.filter.kind[c.vertex] != VertexFilter::Free)
+      continue;
+    if (std::abs(len - 1.0) > 1e-12) c.n /= len;  // unit normals as given, bit for bit
+    im.filter.kind[c.vertex] = VertexFilter::Plane;
+    im.filter.direction[c.vertex] = c.n;
+    im.constraints.push_back(c);
+  }
   struct RestoreFilter {
     Impl& im;
     ~RestoreFilter() {
-      for (const ContactConstraint& c : im.constraints) {
-        if (im.filter.kind[c.vertex] == VertexFilter::Plane)
-          im.filter.kind[c.vertex] = VertexFilter::Free;
-      }
+      for (const ContactConstraint& c : im.constraints)
+        im.filter.kind[c.vertex] = VertexFilter::Free;
     }
   } restore{im};
-  for (const ContactConstraint& c : im.constraints) {
-    if (im.filter.kind[c.vertex] != VertexFilter::Free) continue;
-    im.filter.kind[c.vertex] = VertexFilter::Plane;
-    im.filter.direction[c.vertex] = c.n;
-  }
   // Start: prescribed changes on pinned vertices and along constrained directions, the previous
   // change elsewhere (warm start).
   Vecs dv(n);
@@ -157,10 +153,8 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
   for (const PinnedVertex& p : im.pinned) {
     dv[p.vertex] = (im.pin_target(p, state.time + h) - state.x[p.vertex]) / h - state.v[p.vertex];
   }
-  for (const ContactConstraint& c : im.constraints) {
-    if (im.filter.kind[c.vertex] == VertexFilter::Plane)
-      dv[c.vertex] += c.n * (c.normal_velocity - c.n.dot(state.v[c.vertex]));
-  }
+  for (const ContactConstraint& c : im.constraints)
+    dv[c.vertex] += c.n * (c.normal_velocity - c.n.dot(state.v[c.vertex]));
   const PcgOptions pcg{options_.pcg_max_iterations, options_.pcg_tolerance};
   PcgResult res = solve_pcg(im.h, h * (h + beta), mass, im.b, im.filter, pcg, dv);
   ++stats.solves;
@@ -170,13 +164,12 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
   // from where it stopped (Baraff & Witkin 1998 release the next step; here the same one).
   if (!im.constraints.empty() && std::isfinite(res.relative_residual)) {
     Vecs q(n);
-    multiply(im.h, dv, q);
+    apply_system(im.h, h * (h + beta), mass, dv, q);
     bool released = false;
     for (const ContactConstraint& c : im.constraints) {
       const int i = c.vertex;
       if (im.filter.kind[i] != VertexFilter::Plane) continue;
-      const Vec3 r = im.b[i] - (mass[i] * dv[i] + h * (h + beta) * q[i]);
-      if (c.n.dot(r) > 0.0) {
+      if (c.n.dot(im.b[i] - q[i]) > 0.0) {  // the residual is minus the constraint's force
         im.filter.kind[i] = VertexFilter::Free;
         released = true;
       }

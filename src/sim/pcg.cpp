@@ -28,13 +28,13 @@ double dot(const Vecs& a, const Vecs& b) {
   });
 }
 
-/// y = (M + c H) x
+}  // namespace
+
 void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x,
                   Vecs& y) {
   multiply(h, x, y);
   for_each_vertex(static_cast<int>(x.size()), [&](int i) { y[i] = mass[i] * x[i] + c * y[i]; });
 }
-}  // namespace
 
 PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
                     std::span<const Vec3> b, const VertexFilter& filter, const PcgOptions& options,

@@ -42,6 +42,10 @@ struct PcgResult {
   bool converged = false;
 };
 
+/// y = (diag(mass) + c H) x, the system solve_pcg solves.
+void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x,
+                  Vecs& y);
+
 /// Solves (diag(mass) + c H) dv = b. dv holds the start on entry: its constrained components must
 /// already be the prescribed changes; the free ones are a warm start.
 PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,

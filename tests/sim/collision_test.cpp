@@ -26,20 +26,32 @@ struct OneStep {
   CollisionStats stats;
 };
 
+// The context of one substep from the model's initial positions (the body still when body_t1 is
+// empty). Not copyable: the context points into `inv`.
+struct HandlerSubstep {
+  std::vector<double> inv;
+  SubstepContext ctx;
+  HandlerSubstep(const ClothModel& m, double h, const std::vector<Vec3>& body,
+                 const std::vector<Face>* body_faces, const std::vector<Vec3>& body_t1) {
+    for (double mass : m.mass())
+      inv.push_back(1.0 / mass);
+    ctx.h = h;
+    ctx.x0 = m.initial_positions();
+    ctx.inverse_mass = inv;
+    ctx.cloth = &m.topology();
+    ctx.body_t0 = body;
+    ctx.body_t1 = body_t1.empty() ? body : body_t1;
+    ctx.body_faces = body_faces;
+  }
+  HandlerSubstep(const HandlerSubstep&) = delete;
+  HandlerSubstep& operator=(const HandlerSubstep&) = delete;
+};
+
 OneStep one_step(const ClothModel& m, std::vector<Vec3> v, double h,
                  const std::vector<Vec3>& body = {}, const std::vector<Face>* body_faces = nullptr,
                  const std::vector<Vec3>& body_t1 = {}, const ContactOptions& options = {}) {
-  std::vector<double> inv(m.num_vertices());
-  for (int i = 0; i < m.num_vertices(); ++i)
-    inv[i] = 1.0 / m.mass()[i];
-  SubstepContext ctx;
-  ctx.h = h;
-  ctx.x0 = m.initial_positions();
-  ctx.inverse_mass = inv;
-  ctx.cloth = &m.topology();
-  ctx.body_t0 = body;
-  ctx.body_t1 = body_t1.empty() ? body : body_t1;
-  ctx.body_faces = body_faces;
+  const HandlerSubstep sub(m, h, body, body_faces, body_t1);
+  const SubstepContext& ctx = sub.ctx;
   ContactHandler handler(m, options);
   handler.prepare(ctx);
   OneStep out;
@@ -135,14 +147,11 @@ struct RestingOnRisingBody {
   std::vector<Vec3> body0 = {{-1, 0, -1}, {2, 0, -1}, {-1, 0, 2}};
   std::vector<Vec3> body1;
   std::vector<Face> body_faces = {{0, 2, 1}};
-  std::vector<double> inv;
   double h = 0.01;
   RestingOnRisingBody() : cloth(one_triangle(0.0005), ClothMaterial{}) {
     body1 = body0;
     for (Vec3& b : body1)
       b.y() += 0.1 * h;
-    for (double m : cloth.mass())
-      inv.push_back(1.0 / m);
   }
   static ClothMeshInput one_triangle(double y) {
     ClothMeshInput in;
@@ -151,16 +160,9 @@ struct RestingOnRisingBody {
     return in;
   }
   [[nodiscard]] std::vector<ContactConstraint> constraints(const ContactOptions& o) const {
-    SubstepContext ctx;
-    ctx.h = h;
-    ctx.x0 = cloth.initial_positions();
-    ctx.inverse_mass = inv;
-    ctx.cloth = &cloth.topology();
-    ctx.body_t0 = body0;
-    ctx.body_t1 = body1;
-    ctx.body_faces = &body_faces;
+    const HandlerSubstep sub(cloth, h, body0, &body_faces, body1);
     ContactHandler handler(cloth, o);
-    handler.prepare(ctx);
+    handler.prepare(sub.ctx);
     std::vector<ContactConstraint> out;
     handler.contact_constraints(out);
     return out;
