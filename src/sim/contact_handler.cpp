@@ -129,6 +129,7 @@ struct ContactHandler::Impl {
   Bvh cloth_bvh, body_bvh;
   std::vector<Contact> proximity;
   std::vector<ContactConstraint> constraints;  // see add_constraint()
+  std::vector<ContactCoupling> couplings;      // see add_proximity()
   double constraint_gap = 0.0;
   // This substep's CCD impacts so far and their accumulated impulses (see project()).
   std::vector<Contact> impacts;
@@ -459,6 +460,7 @@ struct ContactHandler::Impl {
     x0m = to_matrix(x0);
     proximity.clear();
     constraints.clear();
+    couplings.clear();
     excluded = 0;
     body_swept = false;
     if (has_body(ctx)) ensure_body(ctx);  // the crossing counter and the body queries need it
@@ -481,12 +483,12 @@ struct ContactHandler::Impl {
       for (const auto& p : r.vf) {
         if (vf_linked(p.vertex, p.face)) continue;
         Contact c;
-        if (make_vf(c, p.vertex, false, p.face, false, 0.0, none)) proximity.push_back(c);
+        if (make_vf(c, p.vertex, false, p.face, false, 0.0, none)) add_proximity(c);
       }
       for (const auto& p : r.ee) {
         if (ee_linked(p.edge_a, p.edge_b)) continue;
         Contact c;
-        if (make_ee(c, p.edge_a, false, p.edge_b, false, 0.0, none)) proximity.push_back(c);
+        if (make_ee(c, p.edge_a, false, p.edge_b, false, 0.0, none)) add_proximity(c);
       }
     }
     if (has_body(ctx)) {
@@ -571,16 +573,35 @@ struct ContactHandler::Impl {
       for (std::size_t i = 0; i < vf_bc.size(); ++i) {
         Contact c;
         if (k_bc[i] && make_vf(c, vf_bc[i].first, true, vf_bc[i].second, false, 0.0, none)) {
-          proximity.push_back(c);
+          add_proximity(c);
         }
       }
       for (std::size_t i = 0; i < ee.size(); ++i) {
         Contact c;
         if (k_ee[i] && make_ee(c, ee[i].first, false, ee[i].second, true, 0.0, none)) {
-          proximity.push_back(c);
+          add_proximity(c);
         }
       }
     }
+  }
+
+  // A proximity contact that no constraint covers; with `coupled_contacts` also a coupling of the
+  // solve: the same target as repulsion, the body points' velocity over the substep as a constant.
+  void add_proximity(const Contact& c) {
+    proximity.push_back(c);
+    if (!opt.coupled_contacts) return;
+    ContactCoupling cc;
+    cc.n = c.n;
+    cc.normal_velocity = opt.repulsion_fraction * (opt.thickness - c.gap) / h;
+    for (int k = 0; k < 4; ++k) {
+      cc.c[k] = c.c[k];
+      if (c.on_body[k]) {
+        cc.body_velocity += c.c[k] * c.n.dot(b1[c.id[k]] - b0[c.id[k]]) / h;
+      } else {
+        cc.vertex[k] = c.id[k];
+      }
+    }
+    couplings.push_back(cc);
   }
 
   // Keeps, per cloth vertex, the constraint of its nearest body face (contacts come sorted by
@@ -1163,6 +1184,10 @@ ContactHandler::~ContactHandler() = default;
 
 void ContactHandler::prepare(const SubstepContext& ctx) {
   impl_->prepare(ctx);
+}
+
+void ContactHandler::contact_couplings(std::vector<ContactCoupling>& out) const {
+  out = impl_->couplings;
 }
 
 void ContactHandler::contact_constraints(std::vector<ContactConstraint>& out) const {

@@ -302,6 +302,7 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                              {"repulsion_sweeps", c.repulsion_sweeps},
                              {"pointwise_repulsion", c.pointwise_repulsion},
                              {"body_constraints", c.body_constraints},
+                             {"coupled_contacts", c.coupled_contacts},
                              {"untangle_step", c.untangle_step},
                              {"zone_motion", c.affine_zones ? "affine" : "rigid"},
                              {"friction", c.friction}};

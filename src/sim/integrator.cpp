@@ -17,6 +17,9 @@
 namespace clothcd::sim {
 namespace {
 constexpr int kGrain = 1024;
+// Stiffness of a contact coupling's penalty, in multiples of the pair's effective mass: the
+// solve leaves about 1/(1 + scale) of the approach it would have without it.
+constexpr double kCouplingScale = 100.0;
 
 template <typename F>
 void for_each_vertex(int n, const F& f) {
@@ -44,6 +47,7 @@ struct ClothSolver::Impl {
   std::vector<double> inverse_mass;
   std::vector<Vec3> body_t0, body_t1;
   std::vector<ContactConstraint> constraints;
+  CouplingTerms couplings;
 
   Vec3 pin_target(const PinnedVertex& p, double t) const {
     const PinGroup& g = groups[p.group];
@@ -155,27 +159,42 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
   }
   for (const ContactConstraint& c : im.constraints)
     dv[c.vertex] += c.n * (c.normal_velocity - c.n.dot(state.v[c.vertex]));
+  // Contact couplings: penalties on the pairs' relative normal velocities, in the matrix and
+  // in the right-hand side.
+  std::vector<ContactCoupling> asked_couplings;
+  if (handler_ != nullptr) handler_->contact_couplings(asked_couplings);
+  im.couplings.reset(asked_couplings, im.inverse_mass, kCouplingScale);
+  const CouplingTerms* ct = im.couplings.empty() ? nullptr : &im.couplings;
+  Vecs rhs = im.b;
+  if (ct != nullptr) ct->add_rhs(state.v, rhs);
   const PcgOptions pcg{options_.pcg_max_iterations, options_.pcg_tolerance};
-  PcgResult res = solve_pcg(im.h, h * (h + beta), mass, im.b, im.filter, pcg, dv);
+  const double c = h * (h + beta);
+  PcgResult res = solve_pcg(im.h, c, mass, rhs, im.filter, pcg, dv, ct);
   ++stats.solves;
   stats.pcg_iterations += res.iterations;
   stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);
-  // A constraint whose force would pull its vertex onto the body is let go, and the solve redone
-  // from where it stopped (Baraff & Witkin 1998 release the next step; here the same one).
-  if (!im.constraints.empty() && std::isfinite(res.relative_residual)) {
+  // A constraint whose force would pull its vertex onto the body, and a coupling that would hold
+  // its pair together, are let go, and the solve redone from where it stopped (Baraff & Witkin
+  // 1998 release the next step; here the same one).
+  if ((!im.constraints.empty() || ct != nullptr) && std::isfinite(res.relative_residual)) {
     Vecs q(n);
-    apply_system(im.h, h * (h + beta), mass, dv, q);
+    apply_system(im.h, c, mass, dv, q, ct);
     bool released = false;
-    for (const ContactConstraint& c : im.constraints) {
-      const int i = c.vertex;
+    for (const ContactConstraint& cc : im.constraints) {
+      const int i = cc.vertex;
       if (im.filter.kind[i] != VertexFilter::Plane) continue;
-      if (c.n.dot(im.b[i] - q[i]) > 0.0) {  // the residual is minus the constraint's force
+      if (cc.n.dot(rhs[i] - q[i]) > 0.0) {  // the residual is minus the constraint's force
         im.filter.kind[i] = VertexFilter::Free;
         released = true;
       }
     }
+    if (ct != nullptr && im.couplings.release_adhesive(state.v, dv) > 0) {
+      released = true;
+      rhs = im.b;
+      ct->add_rhs(state.v, rhs);
+    }
     if (released) {
-      res = solve_pcg(im.h, h * (h + beta), mass, im.b, im.filter, pcg, dv);
+      res = solve_pcg(im.h, c, mass, rhs, im.filter, pcg, dv, ct);
       stats.pcg_iterations += res.iterations;
       stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);
     }

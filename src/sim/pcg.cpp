@@ -30,23 +30,25 @@ double dot(const Vecs& a, const Vecs& b) {
 
 }  // namespace
 
-void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x,
-                  Vecs& y) {
+void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x, Vecs& y,
+                  const CouplingTerms* couplings) {
   multiply(h, x, y);
   for_each_vertex(static_cast<int>(x.size()), [&](int i) { y[i] = mass[i] * x[i] + c * y[i]; });
+  if (couplings != nullptr) couplings->add_product(x, y);
 }
 
 PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
                     std::span<const Vec3> b, const VertexFilter& filter, const PcgOptions& options,
-                    Vecs& dv) {
+                    Vecs& dv, const CouplingTerms* couplings) {
   const int n = static_cast<int>(b.size());
   std::vector<Mat3> pinv(n);
   for_each_vertex(n, [&](int i) {
-    const Mat3 d = mass[i] * Mat3::Identity() + c * h.values[h.diag[i]];
+    Mat3 d = mass[i] * Mat3::Identity() + c * h.values[h.diag[i]];
+    if (couplings != nullptr) couplings->add_diagonal(i, d);
     pinv[i] = d.inverse();
   });
   Vecs r(n), s(n), p(n), q(n), fb(n);
-  apply_system(h, c, mass, dv, q);
+  apply_system(h, c, mass, dv, q, couplings);
   for_each_vertex(n, [&](int i) {
     r[i] = filter.apply(i, b[i] - q[i]);
     fb[i] = filter.apply(i, b[i]);
@@ -64,7 +66,7 @@ PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
     return result;
   }
   for (int it = 0; it < options.max_iterations; ++it) {
-    apply_system(h, c, mass, p, q);
+    apply_system(h, c, mass, p, q, couplings);
     for_each_vertex(n, [&](int i) { q[i] = filter.apply(i, q[i]); });
     const double pq = dot(p, q);
     if (!(pq > 0.0)) break;  // breakdown: PSD matrix and nonzero p make this impossible in theory

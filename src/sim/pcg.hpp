@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "couplings.hpp"
 #include "system.hpp"
 
 namespace clothcd::sim {
@@ -42,14 +43,15 @@ struct PcgResult {
   bool converged = false;
 };
 
-/// y = (diag(mass) + c H) x, the system solve_pcg solves.
-void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x,
-                  Vecs& y);
+/// y = (diag(mass) + c H + K) x, the system solve_pcg solves; K: the active couplings' penalties
+/// (none when `couplings` is null).
+void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x, Vecs& y,
+                  const CouplingTerms* couplings = nullptr);
 
-/// Solves (diag(mass) + c H) dv = b. dv holds the start on entry: its constrained components must
-/// already be the prescribed changes; the free ones are a warm start.
+/// Solves (diag(mass) + c H + K) dv = b. dv holds the start on entry: its constrained components
+/// must already be the prescribed changes; the free ones are a warm start.
 PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
                     std::span<const Vec3> b, const VertexFilter& filter, const PcgOptions& options,
-                    Vecs& dv);
+                    Vecs& dv, const CouplingTerms* couplings = nullptr);
 
 }  // namespace clothcd::sim

@@ -428,6 +428,7 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     c.repulsion_sweeps = o.integer("repulsion_sweeps", c.repulsion_sweeps, 1, 1000);
     c.pointwise_repulsion = o.boolean("pointwise_repulsion", c.pointwise_repulsion);
     c.body_constraints = o.boolean("body_constraints", c.body_constraints);
+    c.coupled_contacts = o.boolean("coupled_contacts", c.coupled_contacts);
     c.full_passes = o.boolean("full_passes", c.full_passes);
     c.untangle_step = o.number("untangle_step", c.untangle_step, 0.0, 1.0);
     c.affine_zones = o.string("zone_motion", c.affine_zones ? "affine" : "rigid",

@@ -200,6 +200,69 @@ struct FaceOnSpike {
   }
 };
 
+// The couplings a handler hands the solve after prepare() at rest.
+std::vector<ContactCoupling> couplings_at(const ClothModel& m, double h,
+                                          const std::vector<Vec3>& body,
+                                          const std::vector<Face>* body_faces,
+                                          const ContactOptions& o) {
+  const HandlerSubstep sub(m, h, body, body_faces, {});
+  ContactHandler handler(m, o);
+  handler.prepare(sub.ctx);
+  std::vector<ContactCoupling> out;
+  handler.contact_couplings(out);
+  return out;
+}
+
+TEST(ContactHandler, ClothLayersInContactBecomeCouplingsOfTheSolve) {
+  // Two separate horizontal triangles 0.5 mm apart, the upper inside the lower in x and z.
+  ClothMeshInput in;
+  in.positions = {{0, 0, 0},          {0.1, 0, 0},        {0, 0, 0.1},
+                  {0.02, 5e-4, 0.02}, {0.06, 5e-4, 0.02}, {0.02, 5e-4, 0.06}};
+  in.faces = {{0, 2, 1}, {3, 5, 4}};
+  const ClothModel m(in, ClothMaterial{});
+  const double h = 0.01;
+  ContactOptions o;
+  const std::vector<ContactCoupling> k = couplings_at(m, h, {}, nullptr, o);
+  // The upper vertices over the lower face; no edge of one is within 1 mm of an edge of the other.
+  ASSERT_EQ(k.size(), 3u);
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_EQ(k[j].vertex[0], 3 + j);
+    EXPECT_EQ((std::array<int, 3>{k[j].vertex[1], k[j].vertex[2], k[j].vertex[3]}),
+              (std::array<int, 3>{0, 2, 1}));
+    EXPECT_NEAR((k[j].n - Vec3(0, 1, 0)).norm(), 0.0, 1e-12);
+    EXPECT_NEAR(k[j].c[0] + k[j].c[1] + k[j].c[2] + k[j].c[3], 0.0, 1e-12);
+    EXPECT_EQ(k[j].body_velocity, 0.0);
+    EXPECT_NEAR(k[j].normal_velocity, 0.1 * 0.0005 / h, 1e-9);  // the repulsion target
+  }
+  o.coupled_contacts = false;
+  EXPECT_TRUE(couplings_at(m, h, {}, nullptr, o).empty());
+}
+
+TEST(ContactHandler, BodyVerticesAndEdgesNearTheClothBecomeCouplingsWithTheBodySideFixed) {
+  const FaceOnSpike s;
+  ContactOptions o;
+  const std::vector<ContactCoupling> k = couplings_at(s.cloth, 0.005, s.body, &s.body_faces, o);
+  // The spike's tip (body vertex 3) under the face: the face's vertices against a body point
+  // below them.
+  int spike = 0;
+  for (const ContactCoupling& c : k) {
+    EXPECT_NEAR(c.c[0] + c.c[1] + c.c[2] + c.c[3], 0.0, 1e-12);
+    EXPECT_EQ(c.body_velocity, 0.0);  // the body stands still
+    EXPECT_TRUE(c.vertex[0] >= 0 || c.vertex[1] >= 0 || c.vertex[2] >= 0 || c.vertex[3] >= 0);
+    if (c.vertex == std::array<int, 4>{-1, 0, 2, 1}) {
+      ++spike;
+      EXPECT_NEAR((c.n - Vec3(0, -1, 0)).norm(), 0.0, 1e-12);
+      EXPECT_NEAR(c.normal_velocity, 0.1 * 0.0005 / 0.005, 1e-9);
+    }
+  }
+  EXPECT_EQ(spike, 1);
+  // Cloth vertex 0 over the plate is a constraint, not a coupling.
+  for (const ContactCoupling& c : k)
+    EXPECT_FALSE(c.vertex[0] == 0 && c.vertex[1] < 0 && c.vertex[2] < 0 && c.vertex[3] < 0);
+  o.coupled_contacts = false;
+  EXPECT_TRUE(couplings_at(s.cloth, 0.005, s.body, &s.body_faces, o).empty());
+}
+
 TEST(ContactHandler, RepulsionDoesNotThrowARestingVertexOffTheBody) {
   const FaceOnSpike s;
   const std::vector<Vec3> v(3, Vec3(0, -1.0, 0));

@@ -274,25 +274,30 @@ TEST(Integrator, UnresolvedHitsAreAcceptedAtTheLastHalvingOrWhenHalvingIsOff) {
   }
 }
 
-// A handler that asks the solve to keep fixed contact constraints and changes nothing after it.
+// A handler that asks the solve to keep fixed contact constraints and couplings and changes
+// nothing after it.
 class FixedConstraints : public CollisionHandler {
  public:
-  explicit FixedConstraints(std::vector<ContactConstraint> c) : c_(std::move(c)) {}
+  explicit FixedConstraints(std::vector<ContactConstraint> c, std::vector<ContactCoupling> k = {})
+      : c_(std::move(c)), k_(std::move(k)) {}
   void prepare(const SubstepContext&) override {}
   void contact_constraints(std::vector<ContactConstraint>& out) const override { out = c_; }
+  void contact_couplings(std::vector<ContactCoupling>& out) const override { out = k_; }
   CollisionStats respond(const SubstepContext&, std::span<Vec3>) override { return {}; }
 
  private:
   std::vector<ContactConstraint> c_;
+  std::vector<ContactCoupling> k_;
 };
 
-// One step of h from rest under the given constraints (none: the free step), PCG to 1e-12.
+// One step of h from rest under the given constraints and couplings (none: the free step), PCG
+// to 1e-12.
 ClothState step_held(const ClothModel& m, std::vector<ContactConstraint> constraints, double h,
-                     StepStats* stats = nullptr) {
+                     StepStats* stats = nullptr, std::vector<ContactCoupling> couplings = {}) {
   SolverOptions opt;
   opt.pcg_tolerance = 1e-12;
   ClothSolver solver(m, opt);
-  FixedConstraints handler(std::move(constraints));
+  FixedConstraints handler(std::move(constraints), std::move(couplings));
   solver.set_collision_handler(&handler);
   ClothState s = solver.initial_state();
   const StepStats st = solver.step(s, h);
@@ -339,6 +344,117 @@ TEST(Integrator, ContactConstraintsOnNoVertexOrAlongNoDirectionAreIgnored) {
                                   {4, Vec3::Zero(), 0.0},
                                   {4, Vec3(0, 1, 0), NAN}},
                                  0.002);
+  for (int i = 0; i < m.num_vertices(); ++i)
+    EXPECT_EQ(s.v[i], f.v[i]) << i;
+}
+
+// Two separate horizontal triangles: the lower (0, 1, 2) at y = 0, the upper (3, 4, 5) 0.5 mm
+// above it and inside it in x and z.
+ClothMeshInput two_layers() {
+  ClothMeshInput in;
+  in.positions = {{0, 0, 0},          {0.1, 0, 0},        {0, 0, 0.1},
+                  {0.02, 5e-4, 0.02}, {0.06, 5e-4, 0.02}, {0.02, 5e-4, 0.06}};
+  in.faces = {{0, 2, 1}, {3, 5, 4}};
+  return in;
+}
+
+// Upper vertex u of two_layers() against the lower face: weights of its point below, normal +y.
+ContactCoupling upper_on_lower(const ClothMeshInput& in, int u, double target) {
+  const Vec3& p = in.positions[u];
+  const double w1 = p.x() / 0.1, w2 = p.z() / 0.1;
+  ContactCoupling c;
+  c.vertex = {u, 0, 1, 2};
+  c.c = {1.0, -(1.0 - w1 - w2), -w1, -w2};
+  c.n = Vec3(0, 1, 0);
+  c.normal_velocity = target;
+  return c;
+}
+
+// The lower layer held still along y by constraints.
+std::vector<ContactConstraint> lower_held() {
+  return {{0, Vec3(0, 1, 0), 0.0}, {1, Vec3(0, 1, 0), 0.0}, {2, Vec3(0, 1, 0), 0.0}};
+}
+
+TEST(Integrator, ContactCouplingKeepsALayerFromFallingOntoTheOneBelow) {
+  const ClothMeshInput in = two_layers();
+  const ClothModel m(in, ClothMaterial{});
+  const double h = 0.002, target = 0.01;
+  const ClothState f = step_held(m, lower_held(), h);
+  std::vector<ContactCoupling> k;
+  for (int u : {3, 4, 5})
+    k.push_back(upper_on_lower(in, u, target));
+  StepStats st;
+  const ClothState s = step_held(m, lower_held(), h, &st, k);
+  for (int u : {3, 4, 5}) {
+    EXPECT_NEAR(f.v[u].y(), -9.81 * h, 1e-9);  // free: the upper layer falls
+    // Coupled: it leaves at most 2% of the free approach beyond the target (the penalty is 100
+    // effective masses), and it is not pushed apart faster than asked either.
+    const double free_gap = f.v[u].y() - target, gap = s.v[u].y() - target;
+    EXPECT_LE(gap, 0.0) << u;
+    EXPECT_GE(gap, 0.02 * free_gap) << u;
+  }
+  for (int i : {0, 1, 2})
+    EXPECT_NEAR(s.v[i].y(), 0.0, 1e-12);  // the held layer stays held
+  EXPECT_EQ(st.solves, 1);
+}
+
+TEST(Integrator, ContactCouplingFollowsTheBodyItTouches) {
+  // The upper triangle against a body point under each vertex that rises at 0.1 m/s: all body
+  // weights, so the whole relative velocity of the other side is body_velocity.
+  const ClothMeshInput in = two_layers();
+  const ClothModel m(in, ClothMaterial{});
+  const double h = 0.002, target = 0.01;
+  std::vector<ContactCoupling> k;
+  for (int u : {3, 4, 5}) {
+    ContactCoupling c;
+    c.vertex = {u, -1, -1, -1};
+    c.c = {1.0, -1.0, 0.0, 0.0};
+    c.n = Vec3(0, 1, 0);
+    c.body_velocity = -1.0 * 0.1;  // c_1 n . v_body
+    c.normal_velocity = target;
+    k.push_back(c);
+  }
+  const ClothState s = step_held(m, lower_held(), h, nullptr, k);
+  for (int u : {3, 4, 5}) {
+    const double free_gap = -9.81 * h - 0.1 - target, gap = s.v[u].y() - 0.1 - target;
+    EXPECT_LE(gap, 0.0) << u;
+    EXPECT_GE(gap, 0.02 * free_gap) << u;
+  }
+}
+
+TEST(Integrator, ContactCouplingThatWouldHoldItsPairTogetherIsLetGo) {
+  // The same pair seen with the normal reversed: gravity separates it, so the coupling would be
+  // adhesive. The step is the free one, redone within the one attempt.
+  const ClothMeshInput in = two_layers();
+  const ClothModel m(in, ClothMaterial{});
+  const double h = 0.002;
+  const ClothState f = step_held(m, lower_held(), h);
+  std::vector<ContactCoupling> k;
+  for (int u : {3, 4, 5}) {
+    ContactCoupling c = upper_on_lower(in, u, 0.0);
+    c.n = -c.n;
+    k.push_back(c);
+  }
+  StepStats st;
+  const ClothState s = step_held(m, lower_held(), h, &st, k);
+  for (int i = 0; i < m.num_vertices(); ++i)
+    EXPECT_LE((s.v[i] - f.v[i]).norm(), 1e-9) << i;
+  EXPECT_EQ(st.solves, 1);
+}
+
+TEST(Integrator, ContactCouplingsOnNoVertexOrAlongNoDirectionAreIgnored) {
+  const ClothMeshInput in = two_layers();
+  const ClothModel m(in, ClothMaterial{});
+  const ClothState f = step_held(m, lower_held(), 0.002);
+  ContactCoupling out_of_range = upper_on_lower(in, 3, 0.01);
+  out_of_range.vertex[1] = m.num_vertices();
+  ContactCoupling no_normal = upper_on_lower(in, 3, 0.01);
+  no_normal.n = Vec3::Zero();
+  ContactCoupling nan_target = upper_on_lower(in, 3, NAN);
+  ContactCoupling body_only = upper_on_lower(in, 3, 0.01);
+  body_only.vertex = {-1, -1, -1, -1};
+  const ClothState s =
+      step_held(m, lower_held(), 0.002, nullptr, {out_of_range, no_normal, nan_target, body_only});
   for (int i = 0; i < m.num_vertices(); ++i)
     EXPECT_EQ(s.v[i], f.v[i]) << i;
 }

@@ -58,15 +58,18 @@ TEST(Scene, UnresolvedHitsHalveTheSubstepUnlessTheSceneSaysNot) {
   EXPECT_FALSE(parse_scene(j, "test-scene.json").solver.halve_unresolved);
 }
 
-TEST(Scene, RepulsionIsPointwiseAndBodyContactsConstrainTheSolveUnlessTheSceneSaysNot) {
+TEST(Scene, RepulsionIsPointwiseAndContactsEnterTheSolveUnlessTheSceneSaysNot) {
   json j = small_grid_scene();
   const Scene on = parse_scene(j, "test-scene.json");
   EXPECT_TRUE(on.contact.pointwise_repulsion);
   EXPECT_TRUE(on.contact.body_constraints);
-  j["collisions"] = {{"pointwise_repulsion", false}, {"body_constraints", false}};
+  EXPECT_TRUE(on.contact.coupled_contacts);
+  j["collisions"] = {
+      {"pointwise_repulsion", false}, {"body_constraints", false}, {"coupled_contacts", false}};
   const Scene off = parse_scene(j, "test-scene.json");
   EXPECT_FALSE(off.contact.pointwise_repulsion);
   EXPECT_FALSE(off.contact.body_constraints);
+  EXPECT_FALSE(off.contact.coupled_contacts);
 }
 
 TEST(Scene, ValidationErrorsNameFileAndKey) {
@@ -101,6 +104,11 @@ TEST(Scene, ValidationErrorsNameFileAndKey) {
          j["collisions"] = {{"body_constraints", "yes"}};
        },
        "'collisions.body_constraints': expected true or false"},
+      {"bad coupling boolean",
+       [](json& j) {
+         j["collisions"] = {{"coupled_contacts", "yes"}};
+       },
+       "'collisions.coupled_contacts': expected true or false"},
       {"bad enum",
        [](json& j) {
          j["output"] = {{"format", "stl"}};

@@ -5,6 +5,7 @@
 /// b_n), then `respond` on the candidate velocities v* (repulsion, friction, CCD impulses, impact
 /// zones). The handler changes v* only; positions follow as x_{n+1} = x_n + h v*.
 
+#include <array>
 #include <span>
 #include <vector>
 
@@ -48,6 +49,20 @@ struct ContactConstraint {
   double normal_velocity = 0.0;
 };
 
+/// Two cloth surfaces (or a cloth face and a body vertex or edge) within the thickness at the
+/// substep start: the dynamics solve keeps their relative normal velocity
+/// n . sum_k c_k v_k + `body_velocity` from falling below `normal_velocity` through a stiff
+/// penalty on it (a contact damper), and lets it go when it would hold the pair together. Why:
+/// repulsion after the solve moved a layer pushed by another layer alone, at up to 2.9 m/s per
+/// substep, while the cloth around it stayed behind (docs/simulator.md 3.1).
+struct ContactCoupling {
+  std::array<int, 4> vertex{-1, -1, -1, -1};  ///< cloth vertices; -1: none (a body point)
+  std::array<double, 4> c{};                  ///< barycentric weights, one side negative
+  Vec3 n = Vec3::Zero();                      ///< unit, from the negative side to the positive
+  double body_velocity = 0.0;                 ///< the body points' share of the relative velocity
+  double normal_velocity = 0.0;
+};
+
 class CollisionHandler {
  public:
   virtual ~CollisionHandler() = default;
@@ -55,6 +70,8 @@ class CollisionHandler {
   virtual void prepare(const SubstepContext& ctx) = 0;
   /// After prepare: the constraints the dynamics solve should keep (default: none).
   virtual void contact_constraints(std::vector<ContactConstraint>& out) const { out.clear(); }
+  /// After prepare: the couplings the dynamics solve should keep (default: none).
+  virtual void contact_couplings(std::vector<ContactCoupling>& out) const { out.clear(); }
   /// After it: adjust v* in place.
   virtual CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v_star) = 0;
 };

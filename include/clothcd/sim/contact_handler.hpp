@@ -39,6 +39,11 @@ struct ContactOptions {
   /// when that would hold them down (docs/simulator.md 3.1); false: only the response after the
   /// solve stops them.
   bool body_constraints = true;
+  /// The other contacts within `thickness` at the substep start (cloth-cloth, and body vertices
+  /// or edges against the cloth) become couplings of the dynamics solve: a stiff penalty keeps
+  /// each pair from approaching faster than the repulsion target, let go when it would hold the
+  /// pair together (docs/simulator.md 3.1); false: only repulsion after the solve separates them.
+  bool coupled_contacts = true;
   /// Every CCD pass and zone round tests every pair (diagnostic). By default, passes after the
   /// first test only pairs with a vertex whose velocity the last response changed or that was in
   /// the last pass's hits: every other pair keeps a motion already tested without a hit, so
@@ -65,6 +70,7 @@ class ContactHandler final : public CollisionHandler {
 
   void prepare(const SubstepContext& ctx) override;
   void contact_constraints(std::vector<ContactConstraint>& out) const override;
+  void contact_couplings(std::vector<ContactCoupling>& out) const override;
   CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v_star) override;
 
   [[nodiscard]] const ContactOptions& options() const { return options_; }
