@@ -141,6 +141,23 @@ TEST(ContactHandler, BodyHasInfiniteMass) {
   EXPECT_TRUE(c.body_pairs(s.x1, body1).empty());
 }
 
+// What a handler hands the dynamics solve after prepare() with the cloth at rest.
+struct SolveContacts {
+  std::vector<ContactConstraint> constraints;
+  std::vector<ContactCoupling> couplings;
+};
+SolveContacts solve_contacts(const ClothModel& m, double h, const std::vector<Vec3>& body,
+                             const std::vector<Face>* body_faces, const std::vector<Vec3>& body_t1,
+                             const ContactOptions& o) {
+  const HandlerSubstep sub(m, h, body, body_faces, body_t1);
+  ContactHandler handler(m, o);
+  handler.prepare(sub.ctx);
+  SolveContacts out;
+  handler.contact_constraints(out.constraints);
+  handler.contact_couplings(out.couplings);
+  return out;
+}
+
 // A cloth triangle resting 0.5 mm above a body triangle that rises at 0.1 m/s.
 struct RestingOnRisingBody {
   ClothModel cloth;
@@ -160,12 +177,7 @@ struct RestingOnRisingBody {
     return in;
   }
   [[nodiscard]] std::vector<ContactConstraint> constraints(const ContactOptions& o) const {
-    const HandlerSubstep sub(cloth, h, body0, &body_faces, body1);
-    ContactHandler handler(cloth, o);
-    handler.prepare(sub.ctx);
-    std::vector<ContactConstraint> out;
-    handler.contact_constraints(out);
-    return out;
+    return solve_contacts(cloth, h, body0, &body_faces, body1, o).constraints;
   }
 };
 
@@ -200,17 +212,11 @@ struct FaceOnSpike {
   }
 };
 
-// The couplings a handler hands the solve after prepare() at rest.
 std::vector<ContactCoupling> couplings_at(const ClothModel& m, double h,
                                           const std::vector<Vec3>& body,
                                           const std::vector<Face>* body_faces,
                                           const ContactOptions& o) {
-  const HandlerSubstep sub(m, h, body, body_faces, {});
-  ContactHandler handler(m, o);
-  handler.prepare(sub.ctx);
-  std::vector<ContactCoupling> out;
-  handler.contact_couplings(out);
-  return out;
+  return solve_contacts(m, h, body, body_faces, {}, o).couplings;
 }
 
 TEST(ContactHandler, ClothLayersInContactBecomeCouplingsOfTheSolve) {
