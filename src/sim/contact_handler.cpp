@@ -585,6 +585,11 @@ struct ContactHandler::Impl {
     }
   }
 
+  // The normal velocity repulsion asks of a proximity contact: a share of its overlap per substep.
+  [[nodiscard]] double repulsion_target(const Contact& c) const {
+    return opt.repulsion_fraction * (opt.thickness - c.gap) / h;
+  }
+
   // A proximity contact that no constraint covers; with `coupled_contacts` also a coupling of the
   // solve: the same target as repulsion, the body points' velocity over the substep as a constant.
   void add_proximity(const Contact& c) {
@@ -592,7 +597,7 @@ struct ContactHandler::Impl {
     if (!opt.coupled_contacts) return;
     ContactCoupling cc;
     cc.n = c.n;
-    cc.normal_velocity = opt.repulsion_fraction * (opt.thickness - c.gap) / h;
+    cc.normal_velocity = repulsion_target(c);
     for (int k = 0; k < 4; ++k) {
       cc.c[k] = c.c[k];
       if (c.on_body[k]) {
@@ -612,7 +617,7 @@ struct ContactHandler::Impl {
     Vec3 vb_point = Vec3::Zero();
     for (int k = 1; k < 4; ++k)
       vb_point -= c.c[k] * (b1[c.id[k]] - b0[c.id[k]]) / h;
-    const double target = opt.repulsion_fraction * (opt.thickness - c.gap) / h;
+    const double target = repulsion_target(c);
     const ContactConstraint cc{v, c.n, c.n.dot(vb_point) + target};
     if (!constraints.empty() && constraints.back().vertex == v) {
       if (c.gap < constraint_gap) {
@@ -934,7 +939,7 @@ struct ContactHandler::Impl {
     for (int sweep = 0; sweep < opt.repulsion_sweeps; ++sweep) {
       bool any = false;
       for (const Contact& c : proximity) {
-        const double target = opt.repulsion_fraction * (opt.thickness - c.gap) / h;
+        const double target = repulsion_target(c);
         const bool friction = sweep == 0 && opt.friction > 0;
         if (opt.pointwise_repulsion && repel_pointwise(c, target, friction, v)) any = true;
         const Vec3 rel = relative_velocity(c, v);

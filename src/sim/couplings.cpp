@@ -51,13 +51,6 @@ void CouplingTerms::reset(std::span<const ContactCoupling> couplings,
   }
 }
 
-int CouplingTerms::active_count() const {
-  int a = 0;
-  for (double k : kappa_)
-    a += k > 0.0 ? 1 : 0;
-  return a;
-}
-
 double CouplingTerms::gap_rate(int j, const Vecs& v, const Vecs* dv) const {
   const ContactCoupling& c = list_[j];
   Vec3 r = Vec3::Zero();
@@ -69,24 +62,7 @@ double CouplingTerms::gap_rate(int j, const Vecs& v, const Vecs* dv) const {
   return c.n.dot(r) + c.body_velocity - c.normal_velocity;
 }
 
-void CouplingTerms::add_product(const Vecs& x, Vecs& y) const {
-  if (list_.empty()) return;
-  const int m = size();
-  std::vector<double> s(m);
-  tbb::parallel_for(tbb::blocked_range<int>(0, m, kGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int j = r.begin(); j < r.end(); ++j) {
-      if (kappa_[j] == 0.0) {
-        s[j] = 0.0;
-        continue;
-      }
-      const ContactCoupling& c = list_[j];
-      Vec3 sum = Vec3::Zero();
-      for (int k = 0; k < 4; ++k) {
-        if (c.vertex[k] >= 0) sum += c.c[k] * x[c.vertex[k]];
-      }
-      s[j] = kappa_[j] * c.n.dot(sum);
-    }
-  });
+void CouplingTerms::scatter(const std::vector<double>& s, Vecs& y) const {
   const int n = static_cast<int>(start_.size()) - 1;
   tbb::parallel_for(tbb::blocked_range<int>(0, n, kGrain), [&](const tbb::blocked_range<int>& r) {
     for (int i = r.begin(); i < r.end(); ++i) {
@@ -96,6 +72,27 @@ void CouplingTerms::add_product(const Vecs& x, Vecs& y) const {
       }
     }
   });
+}
+
+void CouplingTerms::add_product(const Vecs& x, Vecs& y) const {
+  if (list_.empty()) return;
+  const int m = size();
+  scratch_.resize(m);
+  tbb::parallel_for(tbb::blocked_range<int>(0, m, kGrain), [&](const tbb::blocked_range<int>& r) {
+    for (int j = r.begin(); j < r.end(); ++j) {
+      if (kappa_[j] == 0.0) {
+        scratch_[j] = 0.0;
+        continue;
+      }
+      const ContactCoupling& c = list_[j];
+      Vec3 sum = Vec3::Zero();
+      for (int k = 0; k < 4; ++k) {
+        if (c.vertex[k] >= 0) sum += c.c[k] * x[c.vertex[k]];
+      }
+      scratch_[j] = kappa_[j] * c.n.dot(sum);
+    }
+  });
+  scatter(scratch_, y);
 }
 
 void CouplingTerms::add_diagonal(int i, Mat3& d) const {
@@ -108,16 +105,10 @@ void CouplingTerms::add_diagonal(int i, Mat3& d) const {
 }
 
 void CouplingTerms::add_rhs(const Vecs& v, Vecs& b) const {
-  const int n = static_cast<int>(start_.size()) - 1;
-  std::vector<double> g(list_.size());
-  for (int j = 0; j < size(); ++j)
-    g[j] = kappa_[j] == 0.0 ? 0.0 : kappa_[j] * gap_rate(j, v, nullptr);
-  for (int i = 0; i < n; ++i) {
-    for (int e = start_[i]; e < start_[i + 1]; ++e) {
-      const int j = entries_[e] / 4, k = entries_[e] % 4;
-      if (g[j] != 0.0) b[i] -= (list_[j].c[k] * g[j]) * list_[j].n;
-    }
-  }
+  scratch_.resize(list_.size());
+  for (int j = 0; j < size(); ++j)  // negated: b -= ... (exact, so bit for bit the same)
+    scratch_[j] = kappa_[j] == 0.0 ? 0.0 : -(kappa_[j] * gap_rate(j, v, nullptr));
+  scatter(scratch_, b);
 }
 
 int CouplingTerms::release_adhesive(const Vecs& v, const Vecs& dv) {

@@ -20,7 +20,6 @@ class CouplingTerms {
 
   [[nodiscard]] bool empty() const { return list_.empty(); }
   [[nodiscard]] int size() const { return static_cast<int>(list_.size()); }
-  [[nodiscard]] int active_count() const;
 
   /// y += sum over active j of kappa_j c_jk n_j (n_j . sum_k c_jk x_k).
   void add_product(const Vecs& x, Vecs& y) const;
@@ -35,11 +34,14 @@ class CouplingTerms {
 
  private:
   [[nodiscard]] double gap_rate(int j, const Vecs& v, const Vecs* dv) const;
+  /// y_i += sum over i's entries (j, k) of c_jk s_j n_j, per vertex in a fixed order.
+  void scatter(const std::vector<double>& s, Vecs& y) const;
 
   std::vector<ContactCoupling> list_;
-  std::vector<double> kappa_;  // 0 once let go
-  std::vector<int> start_;     // per vertex: range into entries_
-  std::vector<int> entries_;   // coupling * 4 + k
+  std::vector<double> kappa_;            // 0 once let go
+  std::vector<int> start_;               // per vertex: range into entries_
+  std::vector<int> entries_;             // coupling * 4 + k
+  mutable std::vector<double> scratch_;  // per coupling, reused by every product of the solve
 };
 
 }  // namespace clothcd::sim
