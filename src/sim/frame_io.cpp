@@ -289,6 +289,13 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                   {"halve_residual", scene.solver.halve_residual},
                   {"max_halvings", scene.solver.max_halvings},
                   {"halve_unresolved", scene.solver.halve_unresolved}}},
+                {"substeps",
+                 {{"min", scene.substeps.min},
+                  {"max", scene.substeps.max},
+                  {"displacement", scene.substeps.displacement},
+                  {"cloth_displacement", scene.substeps.cloth_displacement},
+                  {"cloth_speed_quantile", scene.substeps.cloth_speed_quantile},
+                  {"near_body", scene.substeps.near_body}}},
                 {"frames", nlohmann::json::array()}};
     if (scene.collisions) {
       const ContactOptions& c = scene.contact;
