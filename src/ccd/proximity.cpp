@@ -7,6 +7,7 @@
 #include "clothcd/ccd/proximity.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -36,14 +37,18 @@ PointTriangleProximity point_triangle_proximity(const Eigen::Vector3d& p, const 
   require_finite({&p, &f0, &f1, &f2}, "point_triangle_proximity");
   PointTriangleProximity best;
   best.distance = INFINITY;
+  double best2 = INFINITY;  // squared distances first, as in edge_edge_proximity
   const Eigen::Vector3d* v[3] = {&f0, &f1, &f2};
   // Boundary: the three edges.
   for (int i = 0; i < 3; ++i) {
     const int j = (i + 1) % 3;
     const double s = point_segment_parameter(p, *v[i], *v[j]);
     const Eigen::Vector3d c = *v[i] + s * (*v[j] - *v[i]);
-    const double d = (p - c).norm();
+    const double d2 = (p - c).squaredNorm();
+    if (!(d2 < best2)) continue;
+    const double d = std::sqrt(d2);
     if (d < best.distance) {
+      best2 = d2;
       best.distance = d;
       best.closest = c;
       best.weights.setZero();
@@ -62,7 +67,8 @@ PointTriangleProximity point_triangle_proximity(const Eigen::Vector3d& p, const 
     const double b = (r2 * g11 - r1 * g12) / det;
     if (a >= 0 && b >= 0 && a + b <= 1) {
       const Eigen::Vector3d c = f0 + a * e1 + b * e2;
-      const double d = (p - c).norm();
+      const double d2 = (p - c).squaredNorm();
+      const double d = d2 < best2 ? std::sqrt(d2) : INFINITY;
       if (d < best.distance) {
         best.distance = d;
         best.closest = c;
@@ -78,11 +84,18 @@ EdgeEdgeProximity edge_edge_proximity(const Eigen::Vector3d& ea0, const Eigen::V
   require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_proximity");
   EdgeEdgeProximity best;
   best.distance = INFINITY;
+  double best2 = INFINITY;
+  // Squared distances first: a candidate no nearer than the best cannot replace it, and one
+  // that is takes the square root and the same test as before, so the result is bit for bit
+  // that of comparing every candidate's distance (sqrt is monotonic).
   auto consider = [&](double s, double t) {
     const Eigen::Vector3d ca = ea0 + s * (ea1 - ea0), cb = eb0 + t * (eb1 - eb0);
-    const double d = (ca - cb).norm();
+    const double d2 = (ca - cb).squaredNorm();
+    if (!(d2 < best2)) return;
+    const double d = std::sqrt(d2);
     if (d < best.distance) {
       best = EdgeEdgeProximity{d, s, t, ca, cb};
+      best2 = d2;
     }
   };
   // Boundary: an endpoint of one segment against the other segment.

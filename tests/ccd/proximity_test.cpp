@@ -2,6 +2,7 @@
 // named degenerate cases with known answers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -32,6 +33,95 @@ double brute_edge_edge(const V& a0, const V& a1, const V& b0, const V& b1, int n
     }
   }
   return best;
+}
+
+// The candidates compared by their distances, every one with its square root: what the
+// squared-distance prefilter of edge_edge_proximity / point_triangle_proximity must reproduce
+// bit for bit (ties included: the first of equal candidates stays).
+EdgeEdgeProximity reference_edge_edge(const V& ea0, const V& ea1, const V& eb0, const V& eb1) {
+  EdgeEdgeProximity best;
+  best.distance = INFINITY;
+  auto consider = [&](double s, double t) {
+    const V ca = ea0 + s * (ea1 - ea0), cb = eb0 + t * (eb1 - eb0);
+    const double d = (ca - cb).norm();
+    if (d < best.distance) best = EdgeEdgeProximity{d, s, t, ca, cb};
+  };
+  consider(0, point_segment_parameter(ea0, eb0, eb1));
+  consider(1, point_segment_parameter(ea1, eb0, eb1));
+  consider(point_segment_parameter(eb0, ea0, ea1), 0);
+  consider(point_segment_parameter(eb1, ea0, ea1), 1);
+  const V da = ea1 - ea0, db = eb1 - eb0, r = ea0 - eb0;
+  const double a = da.dot(da), b = da.dot(db), c = db.dot(db), d = da.dot(r), e = db.dot(r);
+  const double den = a * c - b * b;
+  if (den > 1e-14 * a * c) {
+    consider(std::clamp((b * e - c * d) / den, 0.0, 1.0),
+             std::clamp((a * e - b * d) / den, 0.0, 1.0));
+  }
+  return best;
+}
+
+PointTriangleProximity reference_point_triangle(const V& p, const V& f0, const V& f1, const V& f2) {
+  PointTriangleProximity best;
+  best.distance = INFINITY;
+  const V* v[3] = {&f0, &f1, &f2};
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    const double s = point_segment_parameter(p, *v[i], *v[j]);
+    const V c = *v[i] + s * (*v[j] - *v[i]);
+    const double d = (p - c).norm();
+    if (d < best.distance) {
+      best.distance = d;
+      best.closest = c;
+      best.weights.setZero();
+      best.weights[i] = 1 - s;
+      best.weights[j] = s;
+    }
+  }
+  const V e1 = f1 - f0, e2 = f2 - f0, w = p - f0;
+  const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
+  const double r1 = w.dot(e1), r2 = w.dot(e2);
+  const double det = g11 * g22 - g12 * g12;
+  if (det > 1e-12 * g11 * g22) {
+    const double a = (r1 * g22 - r2 * g12) / det;
+    const double b = (r2 * g11 - r1 * g12) / det;
+    if (a >= 0 && b >= 0 && a + b <= 1) {
+      const V c = f0 + a * e1 + b * e2;
+      const double d = (p - c).norm();
+      if (d < best.distance) {
+        best.distance = d;
+        best.closest = c;
+        best.weights = V(1 - a - b, a, b);
+      }
+    }
+  }
+  return best;
+}
+
+TEST(CcdProximity, SquaredDistancePrefilterChoosesTheSameCandidateBitForBit) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<> u(-1, 1);
+  // Coordinates on a coarse lattice make equal candidate distances (ties) common: parallel and
+  // collinear segments, points above vertices and edges.
+  std::uniform_int_distribution<> lattice(-2, 2);
+  for (int i = 0; i < 20000; ++i) {
+    const bool coarse = i % 2 == 1;
+    auto vec = [&] {
+      return coarse ? V(lattice(rng), lattice(rng), lattice(rng)) : V(u(rng), u(rng), u(rng));
+    };
+    const V a = vec(), b = vec(), c = vec(), d = vec();
+    const EdgeEdgeProximity got = edge_edge_proximity(a, b, c, d);
+    const EdgeEdgeProximity want = reference_edge_edge(a, b, c, d);
+    ASSERT_EQ(got.distance, want.distance) << i;
+    ASSERT_EQ(got.s, want.s) << i;
+    ASSERT_EQ(got.t, want.t) << i;
+    ASSERT_EQ(got.closest_a, want.closest_a) << i;
+    ASSERT_EQ(got.closest_b, want.closest_b) << i;
+    const PointTriangleProximity pt = point_triangle_proximity(a, b, c, d);
+    const PointTriangleProximity pw = reference_point_triangle(a, b, c, d);
+    ASSERT_EQ(pt.distance, pw.distance) << i;
+    ASSERT_EQ(pt.weights, pw.weights) << i;
+    ASSERT_EQ(pt.closest, pw.closest) << i;
+  }
 }
 
 TEST(CcdProximity, RandomAgainstBruteForce) {
