@@ -109,10 +109,34 @@ SystemAssembler::SystemAssembler(const ClothModel& model) : model_(model) {
   face_hess_.resize(9 * na);
   face_grad_.resize(3 * na);
   face_stretch_.resize(na);
+
+  // The matrix handed out: slots no membrane reaches hold their constant part, a multiple of
+  // the identity (checked), as a scalar; the diagonal stays a full block for the preconditioner.
+  matrix_.row_start.assign(n + 1, 0);
+  matrix_.scalar_row_start.assign(n + 1, 0);
+  matrix_.diag.resize(n);
+  for (int i = 0; i < n; ++i) {
+    for (int q = pattern_.row_start[i]; q < pattern_.row_start[i + 1]; ++q) {
+      const Mat3& c = constant_[q];
+      const bool scalar = q != pattern_.diag[i] && slot_src_start_[q] == slot_src_start_[q + 1] &&
+                          c == c(0, 0) * Mat3::Identity();
+      if (scalar) {
+        matrix_.scalar_cols.push_back(pattern_.cols[q]);
+        matrix_.scalar_values.push_back(c(0, 0));
+      } else {
+        if (q == pattern_.diag[i]) matrix_.diag[i] = static_cast<int>(matrix_.cols.size());
+        matrix_.cols.push_back(pattern_.cols[q]);
+        general_slot_.push_back(q);
+      }
+    }
+    matrix_.row_start[i + 1] = static_cast<int>(matrix_.cols.size());
+    matrix_.scalar_row_start[i + 1] = static_cast<int>(matrix_.scalar_cols.size());
+  }
+  matrix_.values.assign(matrix_.cols.size(), Mat3::Zero());
 }
 
 BlockCsr SystemAssembler::make_matrix() const {
-  return pattern_;
+  return matrix_;
 }
 
 double SystemAssembler::assemble(std::span<const Vec3> x, BlockCsr& h, Vecs& gradient) {
@@ -132,16 +156,17 @@ double SystemAssembler::assemble(std::span<const Vec3> x, BlockCsr& h, Vecs& gra
       face_stretch_[k] = e.max_stretch;
     }
   });
-  if (h.values.size() != pattern_.values.size()) h = pattern_;
-  const int slots = static_cast<int>(constant_.size());
-  tbb::parallel_for(tbb::blocked_range<int>(0, slots, 4 * kGrain),
+  if (h.values.size() != matrix_.values.size()) h = matrix_;
+  const int blocks = static_cast<int>(general_slot_.size());
+  tbb::parallel_for(tbb::blocked_range<int>(0, blocks, 4 * kGrain),
                     [&](const tbb::blocked_range<int>& r) {
-                      for (int s = r.begin(); s < r.end(); ++s) {
+                      for (int b = r.begin(); b < r.end(); ++b) {
+                        const int s = general_slot_[b];
                         Mat3 sum = constant_[s];
                         for (int q = slot_src_start_[s]; q < slot_src_start_[s + 1]; ++q) {
                           sum += face_hess_[slot_src_[q]];
                         }
-                        h.values[s] = sum;
+                        h.values[b] = sum;
                       }
                     });
   // Gradient: membrane gathered per vertex, plus the constant part's H_c x.
@@ -193,6 +218,10 @@ void multiply(const BlockCsr& a, std::span<const Vec3> x, std::span<Vec3> y) {
                         Vec3 s = Vec3::Zero();
                         for (int q = a.row_start[i]; q < a.row_start[i + 1]; ++q) {
                           s += a.values[q] * x[a.cols[q]];
+                        }
+                        if (!a.scalar_row_start.empty()) {
+                          for (int q = a.scalar_row_start[i]; q < a.scalar_row_start[i + 1]; ++q)
+                            s += a.scalar_values[q] * x[a.scalar_cols[q]];
                         }
                         y[i] = s;
                       }

@@ -13,12 +13,18 @@ namespace clothcd::sim {
 
 using Vecs = std::vector<Vec3>;
 
-/// Symmetric block matrix in CSR form (both triangles stored).
+/// Symmetric block matrix in CSR form (both triangles stored). Blocks that are a constant
+/// multiple of the identity (only bending and stitch terms reach them: on a cloth about half the
+/// blocks, between the vertices opposite a hinge) may be kept apart as one scalar each, so that a
+/// product reads 8 bytes for them instead of 72.
 struct BlockCsr {
   std::vector<int> row_start;  ///< size n + 1
   std::vector<int> cols;       ///< block column of each slot, ascending per row
   std::vector<int> diag;       ///< slot of (i, i)
   std::vector<Mat3> values;
+  std::vector<int> scalar_row_start;  ///< size n + 1, or empty when there are none
+  std::vector<int> scalar_cols;       ///< ascending per row
+  std::vector<double> scalar_values;  ///< block = scalar_values[q] * I
 
   [[nodiscard]] int rows() const { return static_cast<int>(row_start.size()) - 1; }
   /// Slot of block (i, j); the block must be in the pattern.
@@ -42,7 +48,9 @@ class SystemAssembler {
 
  private:
   const ClothModel& model_;
-  BlockCsr pattern_;
+  BlockCsr pattern_;               // every slot (values unused)
+  BlockCsr matrix_;                // the split form make_matrix() hands out
+  std::vector<int> general_slot_;  // per full block of matrix_: its slot in pattern_
   std::vector<int> active_faces_;
   std::vector<Mat3> constant_;       // bending + stitch Hessian, per slot
   std::vector<int> slot_src_start_;  // per slot: range into slot_src_
@@ -54,7 +62,8 @@ class SystemAssembler {
   std::vector<double> face_stretch_;
 };
 
-/// y = A x for a block matrix (parallel over rows).
+/// y = A x for a block matrix (parallel over rows): per row the full blocks in column order,
+/// then the scalar ones.
 void multiply(const BlockCsr& a, std::span<const Vec3> x, std::span<Vec3> y);
 
 /// Sum over i of f(i) with a split tree fixed by n alone: bitwise equal for any thread count.
