@@ -71,7 +71,6 @@ SystemAssembler::SystemAssembler(const ClothModel& model) : model_(model) {
   pattern_.diag.resize(n);
   for (int i = 0; i < n; ++i)
     pattern_.diag[i] = pattern_.slot(i, i);
-  pattern_.values.assign(keys.size(), Mat3::Zero());
 
   // Constant Hessians: bending K K^T (x) I and stitch w w^T (x) I, summed in element order.
   constant_.assign(keys.size(), Mat3::Zero());

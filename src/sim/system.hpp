@@ -14,9 +14,9 @@ namespace clothcd::sim {
 using Vecs = std::vector<Vec3>;
 
 /// Symmetric block matrix in CSR form (both triangles stored). Blocks that are a constant
-/// multiple of the identity (only bending and stitch terms reach them: on a cloth about half the
-/// blocks, between the vertices opposite a hinge) may be kept apart as one scalar each, so that a
-/// product reads 8 bytes for them instead of 72.
+/// multiple of the identity (only bending and stitch terms reach them, as between the vertices
+/// opposite a hinge: 45% of the multilayer's blocks) may be kept apart as one scalar each, so
+/// that a product reads 8 bytes for them instead of 72.
 struct BlockCsr {
   std::vector<int> row_start;  ///< size n + 1
   std::vector<int> cols;       ///< block column of each slot, ascending per row
@@ -48,7 +48,7 @@ class SystemAssembler {
 
  private:
   const ClothModel& model_;
-  BlockCsr pattern_;               // every slot (values unused)
+  BlockCsr pattern_;               // every slot (no values)
   BlockCsr matrix_;                // the split form make_matrix() hands out
   std::vector<int> general_slot_;  // per full block of matrix_: its slot in pattern_
   std::vector<int> active_faces_;
