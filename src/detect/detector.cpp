@@ -53,7 +53,10 @@ struct SelfDetector::Impl {
   std::vector<std::uint8_t> face_active, vertex_active, edge_active, node_active;
   // Swept boxes of the features, updated where vertices moved (see FeatureBoxes).
   detail::FeatureBoxes boxes;
-  std::vector<std::pair<int, int>> links;  // opt.linked_vertices, normalized per call
+  // opt.linked_vertices normalized by the first detect() after construction or set_options (a
+  // bad id throws there, and again at every call until the options change).
+  std::vector<std::pair<int, int>> links;
+  bool links_current = false;
   detail::Ownership owner;
 
   Impl(std::vector<Face> faces, int nv, const Positions& ref, const DetectOptions& o)
@@ -233,7 +236,10 @@ struct SelfDetector::Impl {
   DetectResult detect(const Positions& p0, const Positions& p1) {
     detail::to_points(p0, topo.num_vertices(), "positions at t0", v0);
     detail::to_points(p1, topo.num_vertices(), "positions at t1", v1);
-    links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
+    if (!links_current) {
+      links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
+      links_current = true;
+    }
     DetectResult res;
     DetectStats& st = res.stats;
     auto t = Clock::now();
@@ -408,6 +414,7 @@ void SelfDetector::set_options(const DetectOptions& options) {
   const BvhBuild build = impl_->opt.build;
   impl_->opt = options;
   impl_->opt.build = build;
+  impl_->links_current = false;
 }
 const Topology& SelfDetector::topology() const {
   return impl_->topo;

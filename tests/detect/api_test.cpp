@@ -321,6 +321,17 @@ TEST(DetectApi, LinkedVerticesDropExactlyThePairsJoiningThem) {
       const DetectResult r = det.detect(s.v_t0, s.v_t1);
       EXPECT_EQ(r.vf, expected.vf) << int(build) << " " << int(culling);
       EXPECT_EQ(r.ee, expected.ee) << int(build) << " " << int(culling);
+      // The links are kept between calls and follow set_options both ways.
+      DetectOptions unlinked = o;
+      unlinked.linked_vertices.clear();
+      det.set_options(unlinked);
+      const DetectResult u = det.detect(s.v_t0, s.v_t1);
+      EXPECT_EQ(u.vf, all.vf) << int(build) << " " << int(culling);
+      EXPECT_EQ(u.ee, all.ee) << int(build) << " " << int(culling);
+      det.set_options(o);
+      const DetectResult again = det.detect(s.v_t0, s.v_t1);
+      EXPECT_EQ(again.vf, expected.vf) << int(build) << " " << int(culling);
+      EXPECT_EQ(again.ee, expected.ee) << int(build) << " " << int(culling);
     }
   }
 }
@@ -331,6 +342,10 @@ TEST(DetectApi, LinkedVertexOutOfRangeIsAnInputError) {
   o.linked_vertices = {{0, s.num_vertices}};
   SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
   EXPECT_THROW((void)det.detect(s.v_t0, s.v_t1), InputError);
+  EXPECT_THROW((void)det.detect(s.v_t0, s.v_t1), InputError);  // still, not only once
+  o.linked_vertices.clear();
+  det.set_options(o);
+  EXPECT_NO_THROW((void)det.detect(s.v_t0, s.v_t1));
 }
 
 }  // namespace
