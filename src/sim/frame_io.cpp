@@ -294,8 +294,7 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                   {"max", scene.substeps.max},
                   {"displacement", scene.substeps.displacement},
                   {"cloth_displacement", scene.substeps.cloth_displacement},
-                  {"cloth_speed_quantile", scene.substeps.cloth_speed_quantile},
-                  {"near_body", scene.substeps.near_body}}},
+                  {"cloth_speed_quantile", scene.substeps.cloth_speed_quantile}}},
                 {"frames", nlohmann::json::array()}};
     if (scene.collisions) {
       const ContactOptions& c = scene.contact;

@@ -247,6 +247,27 @@ std::vector<int> grid_edge(ObjectReader& p, const std::string& which, const Grid
 
 }  // namespace
 
+int SubstepRule::count(double body_displacement, double cloth_displacement_estimate) const {
+  double n = std::ceil(body_displacement / displacement);
+  if (cloth_displacement > 0) {
+    n = std::max(n, std::ceil(cloth_displacement_estimate / cloth_displacement));
+  }
+  if (!(n >= min)) return min;  // also NaN
+  return n > max ? max : static_cast<int>(n);
+}
+
+double SubstepRule::cloth_speed(std::span<const Vec3> v) const {
+  if (v.empty()) return 0.0;
+  std::vector<double> s(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    s[i] = v[i].norm();
+  const double rank = std::ceil(cloth_speed_quantile * static_cast<double>(s.size()));
+  const std::size_t k = rank >= 1.0 ? static_cast<std::size_t>(rank) - 1 : 0;
+  const auto at = s.begin() + static_cast<std::ptrdiff_t>(std::min(k, s.size() - 1));
+  std::nth_element(s.begin(), at, s.end());
+  return *at;
+}
+
 std::filesystem::path data_root_for(const std::filesystem::path& scene_file) {
   if (const char* env = std::getenv("CLOTHCD_DATA"); env != nullptr && *env != '\0') return env;
   const std::filesystem::path dir = std::filesystem::absolute(scene_file).parent_path();
@@ -320,7 +341,6 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
         o.number("cloth_displacement", s.substeps.cloth_displacement, 0.0, 1e6);
     s.substeps.cloth_speed_quantile =
         o.number("cloth_speed_quantile", s.substeps.cloth_speed_quantile, 1e-6, 1.0);
-    s.substeps.near_body = o.number("near_body", s.substeps.near_body, 0.0, 1e6);
     o.finish();
   }
   if (top.has("body")) {

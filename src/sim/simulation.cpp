@@ -59,17 +59,7 @@ FrameStats Simulation::advance_frame() {
   const double t1 = (frame_ + 1) * scene_.frame_dt;
   FrameStats fs;
   fs.body_displacement = scene_.body ? scene_.body->max_displacement(t0, t1) : 0.0;
-  double speed = 0.0;
-  if (scene_.body && scene_.substeps.near_body > 0) {
-    std::vector<Vec3> b0, b1;
-    scene_.body->positions_at(t0, b0);
-    scene_.body->positions_at(t1, b1);
-    for (std::size_t i = 0; i < b0.size(); ++i)
-      b1[i] = (b1[i] - b0[i]) / scene_.frame_dt;  // the body's velocity over the frame
-    speed = scene_.substeps.cloth_speed(state_.x, state_.v, b0, b1, scene_.frame_dt);
-  } else {
-    speed = scene_.substeps.cloth_speed(state_.v);
-  }
+  const double speed = scene_.substeps.cloth_speed(state_.v);
   fs.substeps = scene_.substeps.count(fs.body_displacement, speed * scene_.frame_dt);
   const double h = scene_.frame_dt / fs.substeps;
   for (int k = 0; k < fs.substeps; ++k) {

@@ -192,48 +192,6 @@ TEST(Scene, ClothSpeedQuantileIgnoresTheFewFastestVertices) {
   EXPECT_DOUBLE_EQ(r.cloth_speed({}), 0.0);
 }
 
-// The speed the near-body rule gives one cloth vertex (quantile 1 of a single speed).
-double near_body_speed(const SubstepRule& r, const Vec3& x, const Vec3& v,
-                       const std::vector<Vec3>& body_x, const std::vector<Vec3>& body_v) {
-  const std::vector<Vec3> xs{x}, vs{v};
-  return r.cloth_speed(xs, vs, body_x, body_v, 0.04);
-}
-
-TEST(Scene, ClothSpeedNearTheBodyIsMeasuredAgainstIt) {
-  SubstepRule r;
-  r.near_body = 0.05;
-  // A leg point at the origin moving at 5 m/s, and a still one 0.45 m along x (9 cells away).
-  const std::vector<Vec3> bx{Vec3::Zero(), Vec3(0.45, 0, 0)};
-  const std::vector<Vec3> bv{Vec3(5, 0, 0), Vec3::Zero()};
-  // Carried by the leg: 0 relative to it.
-  EXPECT_DOUBLE_EQ(near_body_speed(r, Vec3(0.01, 0, 0), Vec3(5, 0, 0), bx, bv), 0.0);
-  // Still beside the moving leg: its own speed (the body rule covers the leg's).
-  EXPECT_DOUBLE_EQ(near_body_speed(r, Vec3(0, 0.02, 0), Vec3::Zero(), bx, bv), 0.0);
-  // Out of reach (0.12 m of travel + 0.05 m < 1 m): meets only cloth.
-  EXPECT_DOUBLE_EQ(near_body_speed(r, Vec3(0, 1, 0), Vec3(0, 3, 0), bx, bv), 0.0);
-  // Within reach, flying at the leg: its own speed, the smaller of 3 and 8.
-  EXPECT_DOUBLE_EQ(near_body_speed(r, Vec3(0.1, 0, 0), Vec3(-3, 0, 0), bx, bv), 3.0);
-  // The nearest body point counts, found 3 cells out (0.15 m), not the leg at 0.3 m.
-  EXPECT_DOUBLE_EQ(near_body_speed(r, Vec3(0.3, 0, 0), Vec3(5, 0, 0), bx, bv), 5.0);
-  // Too fast to search for (12 m of travel): its own speed.
-  EXPECT_DOUBLE_EQ(near_body_speed(r, Vec3(0.3, 0, 0), Vec3(300, 0, 0), bx, bv), 300.0);
-  // Off, or without a body: the plain rule.
-  const std::vector<Vec3> x{Vec3(0.01, 0, 0), Vec3(0, 1, 0)}, v{Vec3(5, 0, 0), Vec3(0, 3, 0)};
-  EXPECT_DOUBLE_EQ(r.cloth_speed(x, v, {}, {}, 0.04), 5.0);
-  EXPECT_DOUBLE_EQ(r.cloth_speed(x, v, bx, bv, 0.04), 0.0);
-  r.near_body = 0.0;
-  EXPECT_DOUBLE_EQ(r.cloth_speed(x, v, bx, bv, 0.04), 5.0);
-}
-
-TEST(Scene, NearBodyRuleIsOffUnlessTheSceneSetsIt) {
-  json j = small_grid_scene();
-  EXPECT_EQ(parse_scene(j, "test-scene.json").substeps.near_body, 0.0);
-  j["substeps"] = {{"near_body", 0.05}};
-  EXPECT_EQ(parse_scene(j, "test-scene.json").substeps.near_body, 0.05);
-  j["substeps"] = {{"near_body", -1}};
-  EXPECT_NE(error_of(j).find("substeps.near_body"), std::string::npos) << error_of(j);
-}
-
 std::filesystem::path repo_scene(const char* name) {
   return std::filesystem::path(CLOTHCD_SOURCE_DIR) / "scenes" / name;
 }

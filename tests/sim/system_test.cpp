@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <random>
+#include <set>
+#include <span>
+#include <utility>
 #include <vector>
 
 #include "clothcd/sim/elements.hpp"
@@ -71,13 +74,33 @@ TEST(SystemAssembler, ProductMatchesTheElementsWithIdentityBlocksAsScalars) {
   BlockCsr h = assembler.make_matrix();
   Vecs gradient;
   assembler.assemble(x, h, gradient);
-  // Every vertex pair across a hinge is a scalar block; the diagonal is always a full one.
-  EXPECT_GE(h.scalar_values.size(), m.hinges().size());
+  // The scalar blocks are exactly the vertex pairs that a hinge or a stitch joins and no face
+  // does; the diagonal is always a full block.
+  std::set<std::pair<int, int>> in_face, expected_scalar, scalar;
+  for (const Face& f : m.topology().faces()) {
+    for (int a : f) {
+      for (int b : f)
+        in_face.emplace(a, b);
+    }
+  }
+  auto joined = [&](std::span<const int> vs) {
+    for (int a : vs) {
+      for (int b : vs) {
+        if (a != b && !in_face.count({a, b})) expected_scalar.emplace(a, b);
+      }
+    }
+  };
+  for (const Hinge& hg : m.hinges())
+    joined(hg.v);
+  for (const StitchTerm& st : m.stitches())
+    joined(std::span<const int>(st.v.data(), st.count));
   for (int i = 0; i < h.rows(); ++i) {
     EXPECT_EQ(h.cols[h.diag[i]], i);
     for (int q = h.scalar_row_start[i]; q < h.scalar_row_start[i + 1]; ++q)
-      EXPECT_NE(h.scalar_cols[q], i);
+      scalar.emplace(i, h.scalar_cols[q]);
   }
+  EXPECT_FALSE(expected_scalar.empty());
+  EXPECT_EQ(scalar, expected_scalar);
   for (int trial = 0; trial < 3; ++trial) {
     std::vector<Vec3> r(m.num_vertices());
     for (Vec3& v : r)

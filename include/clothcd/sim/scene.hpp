@@ -32,25 +32,11 @@ struct SubstepRule {
   /// Below 1, a few vertices thrown fast by the response (on the multilayer 0.3% of them moved
   /// faster than 1 m/s while the median was 0.07 m/s) no longer set the substep count for all.
   double cloth_speed_quantile = 1.0;
-  /// When > 0 (m), the cloth rule measures each vertex against the body instead: the smaller of
-  /// its speed and its speed relative to the nearest body vertex, when that vertex lies within
-  /// reach (the cloth vertex's own travel in the frame plus this distance), and 0 otherwise.
-  /// Why: the rule guards against the stop an obstacle gives; cloth carried by the body it
-  /// touches (a skirt on the kicking leg, 5 m/s) is not stopped by it, the body's own speed has
-  /// the `displacement` rule, and cloth out of the body's reach meets only cloth, whose contacts
-  /// the solve couples.
-  double near_body = 0.0;
   /// n = clamp(max(ceil(body displacement in the frame / displacement),
   ///               ceil(cloth speed * frame time / cloth_displacement)), min, max)
   [[nodiscard]] int count(double body_displacement, double cloth_displacement_estimate = 0.0) const;
   /// The cloth speed the rule uses: the `cloth_speed_quantile` of |v| (nearest rank).
   [[nodiscard]] double cloth_speed(std::span<const Vec3> v) const;
-  /// The same quantile of the speeds measured against the body (`near_body`): cloth positions x
-  /// and velocities v, body positions and velocities at the frame's start, the frame's length.
-  /// With `near_body` 0 or no body: cloth_speed(v).
-  [[nodiscard]] double cloth_speed(std::span<const Vec3> x, std::span<const Vec3> v,
-                                   std::span<const Vec3> body_x, std::span<const Vec3> body_v,
-                                   double frame_dt) const;
 };
 
 struct Scene {
