@@ -55,12 +55,18 @@ Vec3 at(const Vec3& x0, const Vec3& x1, double t) {
 }  // namespace
 
 bool distance_filter_culls(const VertexFaceQuery& q, double thickness, int depth) {
-  const double d0 = point_triangle_proximity(q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0).distance;
-  const double d1 = point_triangle_proximity(q.v_t1, q.f0_t1, q.f1_t1, q.f2_t1).distance;
   const double move = largest_relative_move(
       {q.v_t1 - q.v_t0}, {q.f0_t1 - q.f0_t0, q.f1_t1 - q.f1_t0, q.f2_t1 - q.f2_t0});
   const double eps =
       slack({&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0, &q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1});
+  // Lower bounds first: where they cull, the distances would too (the bound grows with them).
+  if (culls(point_triangle_distance_lower_bound(q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0),
+            point_triangle_distance_lower_bound(q.v_t1, q.f0_t1, q.f1_t1, q.f2_t1), move, thickness,
+            eps)) {
+    return true;
+  }
+  const double d0 = point_triangle_proximity(q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0).distance;
+  const double d1 = point_triangle_proximity(q.v_t1, q.f0_t1, q.f1_t1, q.f2_t1).distance;
   return culls_on(0.0, 1.0, d0, d1, move, thickness, eps, depth, [&](double t) {
     return point_triangle_proximity(at(q.v_t0, q.v_t1, t), at(q.f0_t0, q.f0_t1, t),
                                     at(q.f1_t0, q.f1_t1, t), at(q.f2_t0, q.f2_t1, t))
@@ -69,12 +75,17 @@ bool distance_filter_culls(const VertexFaceQuery& q, double thickness, int depth
 }
 
 bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness, int depth) {
-  const double d0 = edge_edge_proximity(q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0).distance;
-  const double d1 = edge_edge_proximity(q.ea0_t1, q.ea1_t1, q.eb0_t1, q.eb1_t1).distance;
   const double move = largest_relative_move({q.ea0_t1 - q.ea0_t0, q.ea1_t1 - q.ea1_t0},
                                             {q.eb0_t1 - q.eb0_t0, q.eb1_t1 - q.eb1_t0});
   const double eps = slack(
       {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0, &q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1});
+  if (culls(edge_edge_distance_lower_bound(q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0),
+            edge_edge_distance_lower_bound(q.ea0_t1, q.ea1_t1, q.eb0_t1, q.eb1_t1), move, thickness,
+            eps)) {
+    return true;
+  }
+  const double d0 = edge_edge_proximity(q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0).distance;
+  const double d1 = edge_edge_proximity(q.ea0_t1, q.ea1_t1, q.eb0_t1, q.eb1_t1).distance;
   return culls_on(0.0, 1.0, d0, d1, move, thickness, eps, depth, [&](double t) {
     return edge_edge_proximity(at(q.ea0_t0, q.ea0_t1, t), at(q.ea1_t0, q.ea1_t1, t),
                                at(q.eb0_t0, q.eb0_t1, t), at(q.eb1_t0, q.eb1_t1, t))

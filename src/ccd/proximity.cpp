@@ -6,8 +6,11 @@
 
 #include "clothcd/ccd/proximity.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 
@@ -21,7 +24,59 @@ void require_finite(std::initializer_list<const Eigen::Vector3d*> points, const 
   }
 }
 
+// The allowance of the lower bounds: far above their rounding error (a few ulps of the
+// coordinates once slivers and near-parallel edges are left out), and the same as the distance
+// filter's slack.
+double allowance(std::initializer_list<const Eigen::Vector3d*> points) {
+  double m = 1.0;
+  for (const Eigen::Vector3d* p : points)
+    m = std::max(m, p->cwiseAbs().maxCoeff());
+  return 1e-12 * m;
+}
+
+// Euclidean gap between the boxes of two point sets (0 where they overlap).
+double box_gap(std::initializer_list<const Eigen::Vector3d*> a,
+               std::initializer_list<const Eigen::Vector3d*> b) {
+  Eigen::Vector3d lo_a = Eigen::Vector3d::Constant(INFINITY), hi_a = -lo_a;
+  Eigen::Vector3d lo_b = lo_a, hi_b = hi_a;
+  for (const Eigen::Vector3d* p : a) {
+    lo_a = lo_a.cwiseMin(*p);
+    hi_a = hi_a.cwiseMax(*p);
+  }
+  for (const Eigen::Vector3d* p : b) {
+    lo_b = lo_b.cwiseMin(*p);
+    hi_b = hi_b.cwiseMax(*p);
+  }
+  const Eigen::Vector3d gap = (lo_b - hi_a).cwiseMax(lo_a - hi_b).cwiseMax(0.0);
+  return gap.norm();
+}
+
+// |w . d| / |w|, or 0 where w is short against |u| |v| (w = u x v): the sine of the angle
+// between u and v is then below 1e-3, and w's direction too uncertain for the bound.
+double along_normal(const Eigen::Vector3d& u, const Eigen::Vector3d& v, const Eigen::Vector3d& d) {
+  const Eigen::Vector3d w = u.cross(v);
+  const double w2 = w.squaredNorm();
+  if (!(w2 > 1e-6 * u.squaredNorm() * v.squaredNorm())) return 0.0;
+  return std::abs(w.dot(d)) / std::sqrt(w2);
+}
+
 }  // namespace
+
+double point_triangle_distance_lower_bound(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
+                                           const Eigen::Vector3d& f1, const Eigen::Vector3d& f2) {
+  require_finite({&p, &f0, &f1, &f2}, "point_triangle_distance_lower_bound");
+  const double bound =
+      std::max(box_gap({&p}, {&f0, &f1, &f2}), along_normal(f1 - f0, f2 - f0, p - f0));
+  return std::max(0.0, bound - allowance({&p, &f0, &f1, &f2}));
+}
+
+double edge_edge_distance_lower_bound(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                                      const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
+  require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_distance_lower_bound");
+  const double bound =
+      std::max(box_gap({&ea0, &ea1}, {&eb0, &eb1}), along_normal(ea1 - ea0, eb1 - eb0, eb0 - ea0));
+  return std::max(0.0, bound - allowance({&ea0, &ea1, &eb0, &eb1}));
+}
 
 double point_segment_parameter(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                const Eigen::Vector3d& b) {

@@ -9,10 +9,9 @@
 #include <optional>
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
+#include "body_pairs.hpp"
 #include "bvh_pairs.hpp"
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/ccd/proximity.hpp"
@@ -81,25 +80,6 @@ class UnionFind {
   std::vector<int> parent_;
 };
 
-// Cloth-body feature pairs of one query: (cloth vertex, body face), (body vertex, cloth face),
-// (cloth edge, body edge).
-struct BodyPairs {
-  std::vector<std::pair<int, int>> vf_cb, vf_bc, ee;
-};
-
-// The threads' lists merged, sorted and without duplicates: the same lists for any thread count.
-BodyPairs merge(tbb::enumerable_thread_specific<BodyPairs>& locals) {
-  BodyPairs out;
-  for (auto m : {&BodyPairs::vf_cb, &BodyPairs::vf_bc, &BodyPairs::ee}) {
-    auto& l = out.*m;
-    for (const BodyPairs& p : locals)
-      l.insert(l.end(), (p.*m).begin(), (p.*m).end());
-    tbb::parallel_sort(l.begin(), l.end());
-    l.erase(std::unique(l.begin(), l.end()), l.end());
-  }
-  return out;
-}
-
 }  // namespace
 
 // How closely hits' times of impact are refined (fraction of the substep, early side): the
@@ -157,6 +137,11 @@ struct ContactHandler::Impl {
   // (cloth held between two body points that move differently) is accepted.
   double sep_scale = 1.0;
   bool body_swept = false;  // body BVH holds this substep's swept boxes
+  // Cloth-body feature pairs (body_pairs.hpp): designated faces, feature boxes, use flags.
+  std::vector<int> cloth_vertex_face, cloth_edge_face, body_vertex_face, body_edge_face;
+  detail::FeatureBoxes cloth_vbox, cloth_ebox, cloth_fbox, body_vbox, body_ebox, body_fbox;
+  std::vector<std::uint8_t> vertex_use, edge_use, face_use;
+  std::vector<std::array<int, 1>> vertex_ids, body_vertex_ids;
   // Restricted passes: cloth vertices whose motion changed (flag), faces and edges touching one,
   // and the cloth BVH nodes holding such a face.
   std::vector<std::uint8_t> vertex_flag, face_flag, edge_flag, node_flag;
@@ -443,12 +428,89 @@ struct ContactHandler::Impl {
     if (body_topo) return;
     const int nb = static_cast<int>(ctx.body_t0.size());
     body_topo.emplace(*ctx.body_faces, nb);
+    detail::designated_faces(model.topology(), cloth_vertex_face, cloth_edge_face);
+    detail::designated_faces(*body_topo, body_vertex_face, body_edge_face);
     cloth_bvh = Bvh(model.topology(), ctx.x0, BvhBuild::Spatial);
     body_bvh = Bvh(*body_topo, ctx.body_t0, BvhBuild::Spatial);
   }
 
   [[nodiscard]] bool has_body(const SubstepContext& ctx) const {
     return opt.body && ctx.body_faces != nullptr && !ctx.body_t0.empty();
+  }
+
+  // Boxes of the features spanned by positions a and b (a == b: static boxes) into `out`, for
+  // the features `use` flags (empty: all).
+  template <std::size_t N>
+  static void fill_boxes(const std::vector<std::array<int, N>>& ids, std::span<const Vec3> a,
+                         std::span<const Vec3> b, std::span<const std::uint8_t> use,
+                         detail::FeatureBoxes& out) {
+    out.resize(ids.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 2048),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                          if (!use.empty() && !use[k]) continue;
+                          Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+                          for (int i : ids[k]) {
+                            lo = lo.cwiseMin(a[i]).cwiseMin(b[i]);
+                            hi = hi.cwiseMax(a[i]).cwiseMax(b[i]);
+                          }
+                          out.lo[k] = lo;
+                          out.hi[k] = hi;
+                        }
+                      });
+  }
+  static std::vector<std::array<int, 1>> singletons(int n) {
+    std::vector<std::array<int, 1>> out(n);
+    for (int i = 0; i < n; ++i)
+      out[i] = {i};
+    return out;
+  }
+
+  // The cloth's feature boxes over x0 -> x1 and its use flags: the flagged features of a
+  // restricted pass (`active`, see set_flags()) that are not escaping.
+  void cloth_boxes(std::span<const Vec3> a, std::span<const Vec3> b,
+                   const std::vector<int>* active) {
+    const Topology& t = model.topology();
+    if (vertex_ids.empty()) vertex_ids = singletons(t.num_vertices());
+    const bool any_escaping = !escapes.empty();
+    const bool all = active == nullptr && !any_escaping;
+    vertex_use.clear();
+    edge_use.clear();
+    face_use.clear();
+    if (!all) {
+      vertex_use.assign(t.num_vertices(), 1);
+      edge_use.assign(t.num_edges(), 1);
+      face_use.assign(t.num_faces(), 1);
+      for (int v = 0; v < t.num_vertices(); ++v)
+        vertex_use[v] = (active == nullptr || vertex_flag[v]) && !escaping[v];
+      for (int e = 0; e < t.num_edges(); ++e) {
+        const Edge& d = t.edges()[e];
+        edge_use[e] = (active == nullptr || edge_flag[e]) && !escaping[d[0]] && !escaping[d[1]];
+      }
+      for (int f = 0; f < t.num_faces(); ++f)
+        face_use[f] = !touches_escaping(t.faces()[f]);
+    }
+    // Face boxes serve the body's vertices; a restricted pass visits flagged faces only.
+    const std::span<const std::uint8_t> faces = active == nullptr
+                                                    ? std::span<const std::uint8_t>{}
+                                                    : std::span<const std::uint8_t>(face_flag);
+    fill_boxes(vertex_ids, a, b, vertex_use, cloth_vbox);
+    fill_boxes(t.edges(), a, b, edge_use, cloth_ebox);
+    fill_boxes(t.faces(), a, b, faces, cloth_fbox);
+  }
+  void body_boxes(std::span<const Vec3> a, std::span<const Vec3> b) {
+    if (body_vertex_ids.empty()) body_vertex_ids = singletons(body_topo->num_vertices());
+    fill_boxes(body_vertex_ids, a, b, {}, body_vbox);
+    fill_boxes(body_topo->edges(), a, b, {}, body_ebox);
+    fill_boxes(body_topo->faces(), a, b, {}, body_fbox);
+  }
+  [[nodiscard]] detail::PairSide cloth_side() const {
+    return {&model.topology(), &cloth_bvh,      &cloth_vbox, &cloth_ebox, &cloth_fbox,
+            cloth_vertex_face, cloth_edge_face, vertex_use,  edge_use,    face_use};
+  }
+  [[nodiscard]] detail::PairSide body_side() const {
+    return {&*body_topo,      &body_bvh,      &body_vbox, &body_ebox, &body_fbox,
+            body_vertex_face, body_edge_face, {},         {},         {}};
   }
 
   void prepare(const SubstepContext& ctx) {
@@ -501,44 +563,11 @@ struct ContactHandler::Impl {
       const auto& bf = body_topo->faces();
       const auto& ce = model.topology().edges();
       const auto& be = body_topo->edges();
-      // Feature boxes grown by d-hat prune most candidates of an overlapping face pair.
-      auto near = [dh](const Vec3& lo_a, const Vec3& hi_a, const Vec3& lo_b, const Vec3& hi_b) {
-        return (lo_a.array() <= hi_b.array() + dh).all() &&
-               (lo_b.array() <= hi_a.array() + dh).all();
-      };
-      auto box = [](std::span<const Vec3> x, std::initializer_list<int> ids, Vec3& lo, Vec3& hi) {
-        lo = Vec3::Constant(INFINITY);
-        hi = Vec3::Constant(-INFINITY);
-        for (int i : ids) {
-          lo = lo.cwiseMin(x[i]);
-          hi = hi.cwiseMax(x[i]);
-        }
-      };
-      tbb::enumerable_thread_specific<BodyPairs> locals;
-      // An escaping vertex's body pairs would hold it inside (see find_escapes()).
-      auto visit = [&](int f, int g, BodyPairs& out) {
-        Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
-        box(x0, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
-        box(b0, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
-        for (int v : cf[f]) {
-          if (!escaping[v] && near(x0[v], x0[v], glo, ghi)) out.vf_cb.emplace_back(v, g);
-        }
-        if (!touches_escaping(cf[f])) {
-          for (int u : bf[g]) {
-            if (near(b0[u], b0[u], flo, fhi)) out.vf_bc.emplace_back(u, f);
-          }
-        }
-        for (int a : model.topology().face_edges(f)) {
-          if (escaping[ce[a][0]] || escaping[ce[a][1]]) continue;
-          box(x0, {ce[a][0], ce[a][1]}, lo, hi);
-          for (int b : body_topo->face_edges(g)) {
-            box(b0, {be[b][0], be[b][1]}, lo2, hi2);
-            if (near(lo, hi, lo2, hi2)) out.ee.emplace_back(a, b);
-          }
-        }
-      };
-      detail::for_each_overlap_parallel(cloth_bvh, body_bvh, locals, visit);
-      const BodyPairs pairs = merge(locals);
+      // Feature boxes within d-hat of each other prune most candidates of an overlapping face
+      // pair; an escaping vertex's body pairs would hold it inside (see find_escapes()).
+      cloth_boxes(x0, x0, nullptr);
+      body_boxes(b0, b0);
+      const detail::BodyPairs pairs = detail::close_feature_pairs(cloth_side(), body_side(), dh);
       const auto& vf_cb = pairs.vf_cb;
       const auto& vf_bc = pairs.vf_bc;
       const auto& ee = pairs.ee;
@@ -552,16 +581,24 @@ struct ContactHandler::Impl {
                           });
         return keep;
       };
+      // The lower bounds first: a pair they put beyond d-hat is beyond it.
       const auto k_cb = within(vf_cb, [&](int v, int g) {
         const Face& t = bf[g];
+        const double lb = point_triangle_distance_lower_bound(x0[v], b0[t[0]], b0[t[1]], b0[t[2]]);
+        if (lb > dh) return lb;
         return point_triangle_proximity(x0[v], b0[t[0]], b0[t[1]], b0[t[2]]).distance;
       });
       const auto k_bc = within(vf_bc, [&](int u, int f) {
         const Face& t = cf[f];
+        const double lb = point_triangle_distance_lower_bound(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]);
+        if (lb > dh) return lb;
         return point_triangle_proximity(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]).distance;
       });
       const auto k_ee = within(ee, [&](int a, int b) {
-        return edge_edge_proximity(x0[ce[a][0]], x0[ce[a][1]], b0[be[b][0]], b0[be[b][1]]).distance;
+        const Vec3 &p = x0[ce[a][0]], &q = x0[ce[a][1]], &r = b0[be[b][0]], &s = b0[be[b][1]];
+        const double lb = edge_edge_distance_lower_bound(p, q, r, s);
+        if (lb > dh) return lb;
+        return edge_edge_proximity(p, q, r, s).distance;
       });
       for (std::size_t i = 0; i < vf_cb.size(); ++i) {
         Contact c;
@@ -743,7 +780,8 @@ struct ContactHandler::Impl {
     ro.cones = false;
     ro.thickness = sep;
     cloth_bvh.refit_changed(x0, x1, ro);  // a later pass redoes the nodes over moved vertices
-    if (!body_swept) {                    // the body's motion is fixed for the substep: refit once
+    const bool refit_body = !body_swept;  // the body's motion is fixed for the substep
+    if (refit_body) {
       body_bvh.refit(b0, b1, ro);
       body_swept = true;
     }
@@ -757,50 +795,12 @@ struct ContactHandler::Impl {
       move_c[i] = (x1[i] - x0[i]).norm();
     for (std::size_t i = 0; i < b0.size(); ++i)
       move_b[i] = (b1[i] - b0[i]).norm();
-    auto swept = [](std::span<const Vec3> a, std::span<const Vec3> b,
-                    std::initializer_list<int> ids, Vec3& lo, Vec3& hi) {
-      lo = Vec3::Constant(INFINITY);
-      hi = Vec3::Constant(-INFINITY);
-      for (int i : ids) {
-        lo = lo.cwiseMin(a[i]).cwiseMin(b[i]);
-        hi = hi.cwiseMax(a[i]).cwiseMax(b[i]);
-      }
-    };
-    auto near = [sep](const Vec3& lo_a, const Vec3& hi_a, const Vec3& lo_b, const Vec3& hi_b) {
-      return (lo_a.array() <= hi_b.array() + sep).all() &&
-             (lo_b.array() <= hi_a.array() + sep).all();
-    };
-    const std::span<const Vec3> x1s = x1;
-    // An escaping vertex's body pairs would hold it inside (see find_escapes()).
-    auto visit = [&](int f, int g, BodyPairs& out) {
-      Vec3 flo, fhi, glo, ghi, lo, hi, lo2, hi2;
-      swept(x0, x1s, {cf[f][0], cf[f][1], cf[f][2]}, flo, fhi);
-      swept(b0, b1, {bf[g][0], bf[g][1], bf[g][2]}, glo, ghi);
-      for (int i : cf[f]) {
-        if (!vertex_flag[i] || escaping[i]) continue;
-        swept(x0, x1s, {i}, lo, hi);
-        if (near(lo, hi, glo, ghi)) out.vf_cb.emplace_back(i, g);
-      }
-      if (!touches_escaping(cf[f])) {
-        for (int u : bf[g]) {
-          swept(b0, b1, {u}, lo, hi);
-          if (near(lo, hi, flo, fhi)) out.vf_bc.emplace_back(u, f);
-        }
-      }
-      for (int a : model.topology().face_edges(f)) {
-        if (!edge_flag[a] || escaping[ce[a][0]] || escaping[ce[a][1]]) continue;
-        swept(x0, x1s, {ce[a][0], ce[a][1]}, lo, hi);
-        for (int b : body_topo->face_edges(g)) {
-          swept(b0, b1, {be[b][0], be[b][1]}, lo2, hi2);
-          if (near(lo, hi, lo2, hi2)) out.ee.emplace_back(a, b);
-        }
-      }
-    };
-    tbb::enumerable_thread_specific<BodyPairs> locals;
-    detail::for_each_overlap_parallel(cloth_bvh, body_bvh, locals, visit,
-                                      active == nullptr ? std::span<const std::uint8_t>{}
-                                                        : std::span<const std::uint8_t>(node_flag));
-    const BodyPairs pairs = merge(locals);
+    cloth_boxes(x0, x1, active);
+    if (refit_body) body_boxes(b0, b1);
+    const detail::BodyPairs pairs =
+        detail::close_feature_pairs(cloth_side(), body_side(), sep,
+                                    active == nullptr ? std::span<const std::uint8_t>{}
+                                                      : std::span<const std::uint8_t>(node_flag));
     const auto& vf_cb = pairs.vf_cb;
     const auto& vf_bc = pairs.vf_bc;
     const auto& ee = pairs.ee;
@@ -831,6 +831,9 @@ struct ContactHandler::Impl {
       if (cloth_vertex_body_face_tangled(i, g)) return Outcome{-2.0, 0.0};
       const Face& t = bf[g];
       const double reach = move_c[i] + std::max({move_b[t[0]], move_b[t[1]], move_b[t[2]]}) + sep;
+      if (point_triangle_distance_lower_bound(x0[i], b0[t[0]], b0[t[1]], b0[t[2]]) > reach) {
+        return Outcome{};
+      }
       const double d0 = point_triangle_proximity(x0[i], b0[t[0]], b0[t[1]], b0[t[2]]).distance;
       return ccd(d0, reach,
                  VertexFaceQuery{x0[i], b0[t[0]], b0[t[1]], b0[t[2]], x1[i], b1[t[0]], b1[t[1]],
@@ -840,6 +843,9 @@ struct ContactHandler::Impl {
       if (body_vertex_cloth_face_tangled(u, f)) return Outcome{-2.0, 0.0};
       const Face& t = cf[f];
       const double reach = move_b[u] + std::max({move_c[t[0]], move_c[t[1]], move_c[t[2]]}) + sep;
+      if (point_triangle_distance_lower_bound(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]) > reach) {
+        return Outcome{};
+      }
       const double d0 = point_triangle_proximity(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]).distance;
       return ccd(d0, reach,
                  VertexFaceQuery{b0[u], x0[t[0]], x0[t[1]], x0[t[2]], b1[u], x1[t[0]], x1[t[1]],
@@ -851,6 +857,9 @@ struct ContactHandler::Impl {
       const Edge& y = be[b];
       const double reach =
           std::max(move_c[x[0]], move_c[x[1]]) + std::max(move_b[y[0]], move_b[y[1]]) + sep;
+      if (edge_edge_distance_lower_bound(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]]) > reach) {
+        return Outcome{};
+      }
       const double d0 = edge_edge_proximity(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]]).distance;
       return ccd(d0, reach,
                  EdgeEdgeQuery{x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], x1[x[0]], x1[x[1]], b1[y[0]],

@@ -34,6 +34,21 @@ struct EdgeEdgeProximity {
                                                     const Eigen::Vector3d& eb0,
                                                     const Eigen::Vector3d& eb1);
 
+/// Lower bounds on the distances above, for culling before the exact query: the gap between the
+/// features' bounding boxes and the distance to the triangle's plane (to the other edge's line
+/// for two edges, skipped for slivers and near-parallel edges), less a rounding allowance of
+/// 1e-12 x max(1, largest coordinate magnitude). Never above the distance the exact function
+/// returns for the same input, and never negative. Finite input is required
+/// (std::invalid_argument otherwise).
+[[nodiscard]] double point_triangle_distance_lower_bound(const Eigen::Vector3d& p,
+                                                         const Eigen::Vector3d& f0,
+                                                         const Eigen::Vector3d& f1,
+                                                         const Eigen::Vector3d& f2);
+[[nodiscard]] double edge_edge_distance_lower_bound(const Eigen::Vector3d& ea0,
+                                                    const Eigen::Vector3d& ea1,
+                                                    const Eigen::Vector3d& eb0,
+                                                    const Eigen::Vector3d& eb1);
+
 /// Closest point parameter of p on segment ab, in [0, 1] (0 for a zero-length segment).
 [[nodiscard]] double point_segment_parameter(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                              const Eigen::Vector3d& b);

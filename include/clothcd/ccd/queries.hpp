@@ -82,7 +82,10 @@ struct CcdResult {
 /// the step is bisected (up to depth times, only where the bound fails and the distance at the
 /// new instant still exceeds the thickness) and the bound applied to each part with its own end
 /// distances: up to 2^depth + 1 distance evaluations that cull near misses the whole-step bound
-/// cannot. NaN or infinite coordinates throw std::invalid_argument.
+/// cannot. The bound is first tried with the distances' cheap lower bounds
+/// (point_triangle_distance_lower_bound, edge_edge_distance_lower_bound): where it culls with
+/// them it culls with the distances, so the answer is the same. NaN or infinite coordinates throw
+/// std::invalid_argument.
 [[nodiscard]] bool distance_filter_culls(const VertexFaceQuery& q, double thickness, int depth = 0);
 [[nodiscard]] bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness, int depth = 0);
 

@@ -1,0 +1,88 @@
+// Cloth-body feature pairs from the leaf pairs of two BVHs, each pair once.
+#include "body_pairs.hpp"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <cstdint>
+
+#include "bvh_pairs.hpp"
+
+namespace clothcd::sim::detail {
+namespace {
+
+bool uses(std::span<const std::uint8_t> flags, int i) {
+  return flags.empty() || flags[i] != 0;
+}
+
+// Sorted as 64-bit keys (first id high, second low; ids are >= 0, so the order is the pairs').
+void sort_pairs(std::vector<std::pair<int, int>>& l) {
+  std::vector<std::uint64_t> keys(l.size());
+  for (std::size_t i = 0; i < l.size(); ++i)
+    keys[i] =
+        static_cast<std::uint64_t>(l[i].first) << 32 | static_cast<std::uint32_t>(l[i].second);
+  tbb::parallel_sort(keys.begin(), keys.end());
+  for (std::size_t i = 0; i < l.size(); ++i)
+    l[i] = {static_cast<int>(keys[i] >> 32), static_cast<int>(keys[i] & 0xffffffffu)};
+}
+
+}  // namespace
+
+void designated_faces(const Topology& topo, std::vector<int>& vertex_face,
+                      std::vector<int>& edge_face) {
+  auto smallest = [](std::span<const int> fs) {
+    return fs.empty() ? -1 : *std::min_element(fs.begin(), fs.end());
+  };
+  vertex_face.resize(topo.num_vertices());
+  for (int v = 0; v < topo.num_vertices(); ++v)
+    vertex_face[v] = smallest(topo.vertex_faces(v));
+  edge_face.resize(topo.num_edges());
+  for (int e = 0; e < topo.num_edges(); ++e)
+    edge_face[e] = smallest(topo.edge_faces(e));
+}
+
+BodyPairs close_feature_pairs(const PairSide& cloth, const PairSide& body, double gap,
+                              std::span<const std::uint8_t> cloth_nodes) {
+  auto near = [gap](const FeatureBoxes& a, int i, const FeatureBoxes& b, int j) {
+    return (a.lo[i].array() <= b.hi[j].array() + gap).all() &&
+           (b.lo[j].array() <= a.hi[i].array() + gap).all();
+  };
+  const auto& cf = cloth.topo->faces();
+  const auto& bf = body.topo->faces();
+  // A feature's box lies in each incident face's, so whenever a feature pair is close, the leaf
+  // pair of the two designated faces overlaps and is visited.
+  auto visit = [&](int f, int g, BodyPairs& out) {
+    for (int v : cf[f]) {
+      if (cloth.vertex_face[v] == f && uses(cloth.vertex_use, v) &&
+          near(*cloth.vertex, v, *body.face, g))
+        out.vf_cb.emplace_back(v, g);
+    }
+    if (uses(cloth.face_use, f)) {
+      for (int u : bf[g]) {
+        if (body.vertex_face[u] == g && uses(body.vertex_use, u) &&
+            near(*body.vertex, u, *cloth.face, f))
+          out.vf_bc.emplace_back(u, f);
+      }
+    }
+    for (int a : cloth.topo->face_edges(f)) {
+      if (cloth.edge_face[a] != f || !uses(cloth.edge_use, a)) continue;
+      for (int b : body.topo->face_edges(g)) {
+        if (body.edge_face[b] == g && uses(body.edge_use, b) && near(*cloth.edge, a, *body.edge, b))
+          out.ee.emplace_back(a, b);
+      }
+    }
+  };
+  tbb::enumerable_thread_specific<BodyPairs> locals;
+  for_each_overlap_parallel(*cloth.bvh, *body.bvh, locals, visit, cloth_nodes);
+  BodyPairs out;
+  for (auto m : {&BodyPairs::vf_cb, &BodyPairs::vf_bc, &BodyPairs::ee}) {
+    auto& l = out.*m;
+    for (const BodyPairs& p : locals)
+      l.insert(l.end(), (p.*m).begin(), (p.*m).end());
+    sort_pairs(l);
+  }
+  return out;
+}
+
+}  // namespace clothcd::sim::detail
