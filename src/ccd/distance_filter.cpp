@@ -1,24 +1,19 @@
 // Distance filter: a lower bound on the features' distance over a linear motion.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <initializer_list>
+#include <stdexcept>
 
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/ccd/queries.hpp"
+#include "distances.hpp"
+#include "slack.hpp"
 
 namespace clothcd {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-
-// Rounding slack of the two distance evaluations: far above their error (a few ulps of the
-// coordinates), far below any thickness a simulator uses.
-double slack(std::initializer_list<const Vec3*> pts) {
-  double m = 1.0;
-  for (const Vec3* p : pts)
-    m = std::max(m, p->cwiseAbs().maxCoeff());
-  return 1e-12 * m;
-}
 
 double largest_relative_move(std::initializer_list<Vec3> a, std::initializer_list<Vec3> b) {
   double d = 0.0;
@@ -52,45 +47,67 @@ Vec3 at(const Vec3& x0, const Vec3& x1, double t) {
   return x0 + t * (x1 - x0);
 }
 
+// A query's four points at t0 and at t1, in the order of the distance functions' arguments, and
+// what tells the two kinds apart: the distance, its lower bound and the largest relative move.
+using Points = std::array<Vec3, 4>;
+Points ends(const VertexFaceQuery& q, bool t1) {
+  return t1 ? Points{q.v_t1, q.f0_t1, q.f1_t1, q.f2_t1} : Points{q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0};
+}
+Points ends(const EdgeEdgeQuery& q, bool t1) {
+  return t1 ? Points{q.ea0_t1, q.ea1_t1, q.eb0_t1, q.eb1_t1}
+            : Points{q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0};
+}
+double distance(const VertexFaceQuery&, const Points& p) {
+  return detail::point_triangle_closest(p[0], p[1], p[2], p[3]).distance;
+}
+double distance(const EdgeEdgeQuery&, const Points& p) {
+  return detail::edge_edge_closest(p[0], p[1], p[2], p[3]).distance;
+}
+double lower_bound(const VertexFaceQuery&, const Points& p) {
+  return detail::point_triangle_bound(p[0], p[1], p[2], p[3]);
+}
+double lower_bound(const EdgeEdgeQuery&, const Points& p) {
+  return detail::edge_edge_bound(p[0], p[1], p[2], p[3]);
+}
+double move(const VertexFaceQuery& q) {
+  return largest_relative_move({q.v_t1 - q.v_t0},
+                               {q.f0_t1 - q.f0_t0, q.f1_t1 - q.f1_t0, q.f2_t1 - q.f2_t0});
+}
+double move(const EdgeEdgeQuery& q) {
+  return largest_relative_move({q.ea0_t1 - q.ea0_t0, q.ea1_t1 - q.ea1_t0},
+                               {q.eb0_t1 - q.eb0_t0, q.eb1_t1 - q.eb1_t0});
+}
+
+template <class Query>
+bool filter_culls(const Query& q, double thickness, int depth) {
+  const Points p0 = ends(q, false), p1 = ends(q, true);
+  for (const Points* p : {&p0, &p1}) {
+    for (const Vec3& x : *p) {
+      if (!x.allFinite()) throw std::invalid_argument("distance_filter_culls: non-finite input");
+    }
+  }
+  const double m = move(q);
+  const double eps =
+      detail::coordinate_slack({&p0[0], &p0[1], &p0[2], &p0[3], &p1[0], &p1[1], &p1[2], &p1[3]});
+  // Lower bounds first: where they cull, the distances would too (the bound grows with them).
+  if (culls(lower_bound(q, p0), lower_bound(q, p1), m, thickness, eps)) return true;
+  return culls_on(0.0, 1.0, distance(q, p0), distance(q, p1), m, thickness, eps, depth,
+                  [&](double t) {
+                    Points pt;
+                    for (int k = 0; k < 4; ++k)
+                      pt[k] = at(p0[k], p1[k], t);
+                    return distance(q, pt);
+                  });
+}
+
 }  // namespace
 
 bool distance_filter_culls(const VertexFaceQuery& q, double thickness, int depth) {
-  const double move = largest_relative_move(
-      {q.v_t1 - q.v_t0}, {q.f0_t1 - q.f0_t0, q.f1_t1 - q.f1_t0, q.f2_t1 - q.f2_t0});
-  const double eps =
-      slack({&q.v_t0, &q.f0_t0, &q.f1_t0, &q.f2_t0, &q.v_t1, &q.f0_t1, &q.f1_t1, &q.f2_t1});
-  // Lower bounds first: where they cull, the distances would too (the bound grows with them).
-  if (culls(point_triangle_distance_lower_bound(q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0),
-            point_triangle_distance_lower_bound(q.v_t1, q.f0_t1, q.f1_t1, q.f2_t1), move, thickness,
-            eps)) {
-    return true;
-  }
-  const double d0 = point_triangle_proximity(q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0).distance;
-  const double d1 = point_triangle_proximity(q.v_t1, q.f0_t1, q.f1_t1, q.f2_t1).distance;
-  return culls_on(0.0, 1.0, d0, d1, move, thickness, eps, depth, [&](double t) {
-    return point_triangle_proximity(at(q.v_t0, q.v_t1, t), at(q.f0_t0, q.f0_t1, t),
-                                    at(q.f1_t0, q.f1_t1, t), at(q.f2_t0, q.f2_t1, t))
-        .distance;
-  });
+  return filter_culls(q, thickness, depth);
 }
 
 bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness, int depth) {
-  const double move = largest_relative_move({q.ea0_t1 - q.ea0_t0, q.ea1_t1 - q.ea1_t0},
-                                            {q.eb0_t1 - q.eb0_t0, q.eb1_t1 - q.eb1_t0});
-  const double eps = slack(
-      {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0, &q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1});
-  if (culls(edge_edge_distance_lower_bound(q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0),
-            edge_edge_distance_lower_bound(q.ea0_t1, q.ea1_t1, q.eb0_t1, q.eb1_t1), move, thickness,
-            eps)) {
-    return true;
-  }
-  const double d0 = edge_edge_proximity(q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0).distance;
-  const double d1 = edge_edge_proximity(q.ea0_t1, q.ea1_t1, q.eb0_t1, q.eb1_t1).distance;
-  return culls_on(0.0, 1.0, d0, d1, move, thickness, eps, depth, [&](double t) {
-    return edge_edge_proximity(at(q.ea0_t0, q.ea0_t1, t), at(q.ea1_t0, q.ea1_t1, t),
-                               at(q.eb0_t0, q.eb0_t1, t), at(q.eb1_t0, q.eb1_t1, t))
-        .distance;
-  });
+  return filter_culls(q, thickness, depth);
 }
 
 }  // namespace clothcd

@@ -6,6 +6,9 @@
 
 #include "clothcd/ccd/proximity.hpp"
 
+#include "distances.hpp"
+#include "slack.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -22,16 +25,6 @@ void require_finite(std::initializer_list<const Eigen::Vector3d*> points, const 
   for (const Eigen::Vector3d* p : points) {
     if (!p->allFinite()) throw std::invalid_argument(std::string(what) + ": non-finite input");
   }
-}
-
-// The allowance of the lower bounds: far above their rounding error (a few ulps of the
-// coordinates once slivers and near-parallel edges are left out), and the same as the distance
-// filter's slack.
-double allowance(std::initializer_list<const Eigen::Vector3d*> points) {
-  double m = 1.0;
-  for (const Eigen::Vector3d* p : points)
-    m = std::max(m, p->cwiseAbs().maxCoeff());
-  return 1e-12 * m;
 }
 
 // Euclidean gap between the boxes of two point sets (0 where they overlap).
@@ -62,34 +55,26 @@ double along_normal(const Eigen::Vector3d& u, const Eigen::Vector3d& v, const Ei
 
 }  // namespace
 
-double point_triangle_distance_lower_bound(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
-                                           const Eigen::Vector3d& f1, const Eigen::Vector3d& f2) {
-  require_finite({&p, &f0, &f1, &f2}, "point_triangle_distance_lower_bound");
+namespace detail {
+
+// The lower bounds less their rounding allowance, input already checked.
+double point_triangle_bound(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
+                            const Eigen::Vector3d& f1, const Eigen::Vector3d& f2) {
   const double bound =
       std::max(box_gap({&p}, {&f0, &f1, &f2}), along_normal(f1 - f0, f2 - f0, p - f0));
-  return std::max(0.0, bound - allowance({&p, &f0, &f1, &f2}));
+  return std::max(0.0, bound - coordinate_slack({&p, &f0, &f1, &f2}));
 }
-
-double edge_edge_distance_lower_bound(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
-                                      const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
-  require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_distance_lower_bound");
+double edge_edge_bound(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                       const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
   const double bound =
       std::max(box_gap({&ea0, &ea1}, {&eb0, &eb1}), along_normal(ea1 - ea0, eb1 - eb0, eb0 - ea0));
-  return std::max(0.0, bound - allowance({&ea0, &ea1, &eb0, &eb1}));
+  return std::max(0.0, bound - coordinate_slack({&ea0, &ea1, &eb0, &eb1}));
 }
 
-double point_segment_parameter(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                               const Eigen::Vector3d& b) {
-  const Eigen::Vector3d e = b - a;
-  const double len2 = e.squaredNorm();
-  if (!(len2 > 0)) return 0;
-  return std::clamp((p - a).dot(e) / len2, 0.0, 1.0);
-}
-
-PointTriangleProximity point_triangle_proximity(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
-                                                const Eigen::Vector3d& f1,
-                                                const Eigen::Vector3d& f2) {
-  require_finite({&p, &f0, &f1, &f2}, "point_triangle_proximity");
+// The closest points, input already checked.
+PointTriangleProximity point_triangle_closest(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
+                                              const Eigen::Vector3d& f1,
+                                              const Eigen::Vector3d& f2) {
   PointTriangleProximity best;
   best.distance = INFINITY;
   double best2 = INFINITY;  // squared distances first, as in edge_edge_proximity
@@ -134,9 +119,8 @@ PointTriangleProximity point_triangle_proximity(const Eigen::Vector3d& p, const 
   return best;
 }
 
-EdgeEdgeProximity edge_edge_proximity(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
-                                      const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
-  require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_proximity");
+EdgeEdgeProximity edge_edge_closest(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                                    const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
   EdgeEdgeProximity best;
   best.distance = INFINITY;
   double best2 = INFINITY;
@@ -169,6 +153,57 @@ EdgeEdgeProximity edge_edge_proximity(const Eigen::Vector3d& ea0, const Eigen::V
     consider(s, t);
   }
   return best;
+}
+
+}  // namespace detail
+
+double point_triangle_distance_lower_bound(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
+                                           const Eigen::Vector3d& f1, const Eigen::Vector3d& f2) {
+  require_finite({&p, &f0, &f1, &f2}, "point_triangle_distance_lower_bound");
+  return detail::point_triangle_bound(p, f0, f1, f2);
+}
+
+double edge_edge_distance_lower_bound(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                                      const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
+  require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_distance_lower_bound");
+  return detail::edge_edge_bound(ea0, ea1, eb0, eb1);
+}
+
+double point_triangle_distance_if_within(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
+                                         const Eigen::Vector3d& f1, const Eigen::Vector3d& f2,
+                                         double limit) {
+  require_finite({&p, &f0, &f1, &f2}, "point_triangle_distance_if_within");
+  const double bound = detail::point_triangle_bound(p, f0, f1, f2);
+  return bound > limit ? bound : detail::point_triangle_closest(p, f0, f1, f2).distance;
+}
+
+double edge_edge_distance_if_within(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                                    const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1,
+                                    double limit) {
+  require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_distance_if_within");
+  const double bound = detail::edge_edge_bound(ea0, ea1, eb0, eb1);
+  return bound > limit ? bound : detail::edge_edge_closest(ea0, ea1, eb0, eb1).distance;
+}
+
+double point_segment_parameter(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                               const Eigen::Vector3d& b) {
+  const Eigen::Vector3d e = b - a;
+  const double len2 = e.squaredNorm();
+  if (!(len2 > 0)) return 0;
+  return std::clamp((p - a).dot(e) / len2, 0.0, 1.0);
+}
+
+PointTriangleProximity point_triangle_proximity(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
+                                                const Eigen::Vector3d& f1,
+                                                const Eigen::Vector3d& f2) {
+  require_finite({&p, &f0, &f1, &f2}, "point_triangle_proximity");
+  return detail::point_triangle_closest(p, f0, f1, f2);
+}
+
+EdgeEdgeProximity edge_edge_proximity(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                                      const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
+  require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_proximity");
+  return detail::edge_edge_closest(ea0, ea1, eb0, eb1);
 }
 
 }  // namespace clothcd

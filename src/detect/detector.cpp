@@ -301,15 +301,12 @@ struct SelfDetector::Impl {
     tbb::enumerable_thread_specific<Buffer> locals;
     auto kvf = [&](int v, int f, Buffer& out) {
       const Face& t = topo.faces()[f];
-      // The lower bound (box gap, plane distance) rejects far pairs for a few dot products.
-      if (point_triangle_distance_lower_bound(v0[v], v0[t[0]], v0[t[1]], v0[t[2]]) > h) return;
-      const double d = point_triangle_proximity(v0[v], v0[t[0]], v0[t[1]], v0[t[2]]).distance;
+      const double d = point_triangle_distance_if_within(v0[v], v0[t[0]], v0[t[1]], v0[t[2]], h);
       if (d <= h) out.vf.push_back({v, f, d});
     };
     auto kee = [&](int a, int b, Buffer& out) {
       const Edge &ea = topo.edges()[a], &eb = topo.edges()[b];
-      if (edge_edge_distance_lower_bound(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]]) > h) return;
-      const double d = edge_edge_proximity(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]]).distance;
+      const double d = edge_edge_distance_if_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
       if (d <= h) out.ee.push_back({a, b, d});
     };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),

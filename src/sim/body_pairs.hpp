@@ -5,6 +5,7 @@
 // pair of its features' designated faces, so it comes once: no duplicates to sort away (the sort
 // of the duplicated lists took 37% of the cloth-body queries on multilayer-rumba frame 61).
 
+#include <cstdint>
 #include <span>
 #include <utility>
 #include <vector>
@@ -16,22 +17,29 @@
 namespace clothcd::sim::detail {
 
 /// Axis-aligned boxes, one per feature, as corner lists.
-struct FeatureBoxes {
+struct BoxList {
   std::vector<Vec3> lo, hi;
-  void resize(std::size_t n) {
-    lo.resize(n);
-    hi.resize(n);
-  }
 };
+
+/// The boxes of a mesh's vertices, edges and faces.
+struct MeshBoxes {
+  BoxList vertex, edge, face;
+};
+
+/// Fills `out` with the boxes of the features of `topo` spanned by positions a and b (a == b:
+/// static boxes), for the features whose use flag is set (empty: all); the others keep what they
+/// held.
+void fill_feature_boxes(const Topology& topo, std::span<const Vec3> a, std::span<const Vec3> b,
+                        std::span<const std::uint8_t> vertex_use,
+                        std::span<const std::uint8_t> edge_use,
+                        std::span<const std::uint8_t> face_use, MeshBoxes& out);
 
 /// One mesh of the query. Boxes are read only for the features used (and, for faces, those
 /// below the flagged nodes); `*_use` empty means all.
 struct PairSide {
   const Topology* topo = nullptr;
   const Bvh* bvh = nullptr;
-  const FeatureBoxes* vertex = nullptr;
-  const FeatureBoxes* edge = nullptr;
-  const FeatureBoxes* face = nullptr;
+  const MeshBoxes* boxes = nullptr;
   std::span<const int> vertex_face, edge_face;  ///< designated faces (designated_faces())
   std::span<const std::uint8_t> vertex_use, edge_use;
   /// Faces that may pair with the other mesh's vertices (the cloth's: not escaping ones).

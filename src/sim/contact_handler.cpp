@@ -139,12 +139,11 @@ struct ContactHandler::Impl {
   bool body_swept = false;  // body BVH holds this substep's swept boxes
   // Cloth-body feature pairs (body_pairs.hpp): designated faces, feature boxes, use flags.
   std::vector<int> cloth_vertex_face, cloth_edge_face, body_vertex_face, body_edge_face;
-  detail::FeatureBoxes cloth_vbox, cloth_ebox, cloth_fbox, body_vbox, body_ebox, body_fbox;
-  std::vector<std::uint8_t> vertex_use, edge_use, face_use;
-  std::vector<std::array<int, 1>> vertex_ids, body_vertex_ids;
-  // Restricted passes: cloth vertices whose motion changed (flag), faces and edges touching one,
-  // and the cloth BVH nodes holding such a face.
-  std::vector<std::uint8_t> vertex_flag, face_flag, edge_flag, node_flag;
+  detail::MeshBoxes cloth_boxes, body_boxes;
+  std::vector<std::uint8_t> vertex_use, edge_use, face_use;  // see set_scope()
+  // Restricted passes: cloth faces touching a vertex whose motion changed, and the cloth BVH
+  // nodes holding such a face (see set_scope()).
+  std::vector<std::uint8_t> face_flag, node_flag;
   // Per-substep scratch.
   std::span<const Vec3> x0, b0, b1;
   std::vector<Vec3> vb;
@@ -438,79 +437,45 @@ struct ContactHandler::Impl {
     return opt.body && ctx.body_faces != nullptr && !ctx.body_t0.empty();
   }
 
-  // Boxes of the features spanned by positions a and b (a == b: static boxes) into `out`, for
-  // the features `use` flags (empty: all).
-  template <std::size_t N>
-  static void fill_boxes(const std::vector<std::array<int, N>>& ids, std::span<const Vec3> a,
-                         std::span<const Vec3> b, std::span<const std::uint8_t> use,
-                         detail::FeatureBoxes& out) {
-    out.resize(ids.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 2048),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-                          if (!use.empty() && !use[k]) continue;
-                          Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
-                          for (int i : ids[k]) {
-                            lo = lo.cwiseMin(a[i]).cwiseMin(b[i]);
-                            hi = hi.cwiseMax(a[i]).cwiseMax(b[i]);
-                          }
-                          out.lo[k] = lo;
-                          out.hi[k] = hi;
-                        }
-                      });
-  }
-  static std::vector<std::array<int, 1>> singletons(int n) {
-    std::vector<std::array<int, 1>> out(n);
-    for (int i = 0; i < n; ++i)
-      out[i] = {i};
-    return out;
-  }
-
-  // The cloth's feature boxes over x0 -> x1 and its use flags: the flagged features of a
-  // restricted pass (`active`, see set_flags()) that are not escaping.
-  void cloth_boxes(std::span<const Vec3> a, std::span<const Vec3> b,
-                   const std::vector<int>* active) {
+  // What a cloth-body query uses of the cloth (empty: all): in a restricted pass (`active`: the
+  // vertices whose motion changed) the active vertices, the edges touching one, the faces
+  // touching one (face_flag) and the BVH nodes holding such a face (node_flag); never an
+  // escaping vertex's features (their body pairs would hold it inside, see find_escapes()).
+  void set_scope(const std::vector<int>* active) {
     const Topology& t = model.topology();
-    if (vertex_ids.empty()) vertex_ids = singletons(t.num_vertices());
-    const bool any_escaping = !escapes.empty();
-    const bool all = active == nullptr && !any_escaping;
     vertex_use.clear();
     edge_use.clear();
     face_use.clear();
-    if (!all) {
-      vertex_use.assign(t.num_vertices(), 1);
-      edge_use.assign(t.num_edges(), 1);
-      face_use.assign(t.num_faces(), 1);
-      for (int v = 0; v < t.num_vertices(); ++v)
-        vertex_use[v] = (active == nullptr || vertex_flag[v]) && !escaping[v];
-      for (int e = 0; e < t.num_edges(); ++e) {
-        const Edge& d = t.edges()[e];
-        edge_use[e] = (active == nullptr || edge_flag[e]) && !escaping[d[0]] && !escaping[d[1]];
-      }
-      for (int f = 0; f < t.num_faces(); ++f)
-        face_use[f] = !touches_escaping(t.faces()[f]);
+    face_flag.clear();
+    node_flag.clear();
+    if (active != nullptr) {
+      vertex_use.assign(t.num_vertices(), 0);
+      for (int i : *active)
+        vertex_use[i] = 1;
+      face_flag = t.faces_touching(vertex_use);
+      edge_use = t.edges_touching(vertex_use);
+      node_flag = cloth_bvh.nodes_holding(face_flag);
     }
-    // Face boxes serve the body's vertices; a restricted pass visits flagged faces only.
-    const std::span<const std::uint8_t> faces = active == nullptr
-                                                    ? std::span<const std::uint8_t>{}
-                                                    : std::span<const std::uint8_t>(face_flag);
-    fill_boxes(vertex_ids, a, b, vertex_use, cloth_vbox);
-    fill_boxes(t.edges(), a, b, edge_use, cloth_ebox);
-    fill_boxes(t.faces(), a, b, faces, cloth_fbox);
+    if (escapes.empty()) return;
+    if (vertex_use.empty()) vertex_use.assign(t.num_vertices(), 1);
+    if (edge_use.empty()) edge_use.assign(t.num_edges(), 1);
+    face_use.assign(t.num_faces(), 1);
+    for (int v = 0; v < t.num_vertices(); ++v)
+      vertex_use[v] = vertex_use[v] && !escaping[v];
+    for (int e = 0; e < t.num_edges(); ++e) {
+      const Edge& d = t.edges()[e];
+      edge_use[e] = edge_use[e] && !escaping[d[0]] && !escaping[d[1]];
+    }
+    for (int f = 0; f < t.num_faces(); ++f)
+      face_use[f] = !touches_escaping(t.faces()[f]);
   }
-  void body_boxes(std::span<const Vec3> a, std::span<const Vec3> b) {
-    if (body_vertex_ids.empty()) body_vertex_ids = singletons(body_topo->num_vertices());
-    fill_boxes(body_vertex_ids, a, b, {}, body_vbox);
-    fill_boxes(body_topo->edges(), a, b, {}, body_ebox);
-    fill_boxes(body_topo->faces(), a, b, {}, body_fbox);
-  }
+
   [[nodiscard]] detail::PairSide cloth_side() const {
-    return {&model.topology(), &cloth_bvh,      &cloth_vbox, &cloth_ebox, &cloth_fbox,
-            cloth_vertex_face, cloth_edge_face, vertex_use,  edge_use,    face_use};
+    return {&model.topology(), &cloth_bvh, &cloth_boxes, cloth_vertex_face,
+            cloth_edge_face,   vertex_use, edge_use,     face_use};
   }
   [[nodiscard]] detail::PairSide body_side() const {
-    return {&*body_topo,      &body_bvh,      &body_vbox, &body_ebox, &body_fbox,
-            body_vertex_face, body_edge_face, {},         {},         {}};
+    return {&*body_topo, &body_bvh, &body_boxes, body_vertex_face, body_edge_face, {}, {}, {}};
   }
 
   void prepare(const SubstepContext& ctx) {
@@ -565,8 +530,9 @@ struct ContactHandler::Impl {
       const auto& be = body_topo->edges();
       // Feature boxes within d-hat of each other prune most candidates of an overlapping face
       // pair; an escaping vertex's body pairs would hold it inside (see find_escapes()).
-      cloth_boxes(x0, x0, nullptr);
-      body_boxes(b0, b0);
+      set_scope(nullptr);
+      detail::fill_feature_boxes(model.topology(), x0, x0, vertex_use, edge_use, {}, cloth_boxes);
+      detail::fill_feature_boxes(*body_topo, b0, b0, {}, {}, {}, body_boxes);
       const detail::BodyPairs pairs = detail::close_feature_pairs(cloth_side(), body_side(), dh);
       const auto& vf_cb = pairs.vf_cb;
       const auto& vf_bc = pairs.vf_bc;
@@ -581,24 +547,17 @@ struct ContactHandler::Impl {
                           });
         return keep;
       };
-      // The lower bounds first: a pair they put beyond d-hat is beyond it.
       const auto k_cb = within(vf_cb, [&](int v, int g) {
         const Face& t = bf[g];
-        const double lb = point_triangle_distance_lower_bound(x0[v], b0[t[0]], b0[t[1]], b0[t[2]]);
-        if (lb > dh) return lb;
-        return point_triangle_proximity(x0[v], b0[t[0]], b0[t[1]], b0[t[2]]).distance;
+        return point_triangle_distance_if_within(x0[v], b0[t[0]], b0[t[1]], b0[t[2]], dh);
       });
       const auto k_bc = within(vf_bc, [&](int u, int f) {
         const Face& t = cf[f];
-        const double lb = point_triangle_distance_lower_bound(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]);
-        if (lb > dh) return lb;
-        return point_triangle_proximity(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]).distance;
+        return point_triangle_distance_if_within(b0[u], x0[t[0]], x0[t[1]], x0[t[2]], dh);
       });
       const auto k_ee = within(ee, [&](int a, int b) {
-        const Vec3 &p = x0[ce[a][0]], &q = x0[ce[a][1]], &r = b0[be[b][0]], &s = b0[be[b][1]];
-        const double lb = edge_edge_distance_lower_bound(p, q, r, s);
-        if (lb > dh) return lb;
-        return edge_edge_proximity(p, q, r, s).distance;
+        return edge_edge_distance_if_within(x0[ce[a][0]], x0[ce[a][1]], b0[be[b][0]], b0[be[b][1]],
+                                            dh);
       });
       for (std::size_t i = 0; i < vf_cb.size(); ++i) {
         Contact c;
@@ -785,7 +744,7 @@ struct ContactHandler::Impl {
       body_bvh.refit(b0, b1, ro);
       body_swept = true;
     }
-    set_flags(active);
+    set_scope(active);
     const auto& cf = model.topology().faces();
     const auto& bf = body_topo->faces();
     const auto& ce = model.topology().edges();
@@ -795,12 +754,12 @@ struct ContactHandler::Impl {
       move_c[i] = (x1[i] - x0[i]).norm();
     for (std::size_t i = 0; i < b0.size(); ++i)
       move_b[i] = (b1[i] - b0[i]).norm();
-    cloth_boxes(x0, x1, active);
-    if (refit_body) body_boxes(b0, b1);
+    // Face boxes serve the body's vertices; a restricted pass visits the flagged faces only.
+    detail::fill_feature_boxes(model.topology(), x0, x1, vertex_use, edge_use, face_flag,
+                               cloth_boxes);
+    if (refit_body) detail::fill_feature_boxes(*body_topo, b0, b1, {}, {}, {}, body_boxes);
     const detail::BodyPairs pairs =
-        detail::close_feature_pairs(cloth_side(), body_side(), sep,
-                                    active == nullptr ? std::span<const std::uint8_t>{}
-                                                      : std::span<const std::uint8_t>(node_flag));
+        detail::close_feature_pairs(cloth_side(), body_side(), sep, node_flag);
     const auto& vf_cb = pairs.vf_cb;
     const auto& vf_bc = pairs.vf_bc;
     const auto& ee = pairs.ee;
@@ -831,10 +790,8 @@ struct ContactHandler::Impl {
       if (cloth_vertex_body_face_tangled(i, g)) return Outcome{-2.0, 0.0};
       const Face& t = bf[g];
       const double reach = move_c[i] + std::max({move_b[t[0]], move_b[t[1]], move_b[t[2]]}) + sep;
-      if (point_triangle_distance_lower_bound(x0[i], b0[t[0]], b0[t[1]], b0[t[2]]) > reach) {
-        return Outcome{};
-      }
-      const double d0 = point_triangle_proximity(x0[i], b0[t[0]], b0[t[1]], b0[t[2]]).distance;
+      const double d0 =
+          point_triangle_distance_if_within(x0[i], b0[t[0]], b0[t[1]], b0[t[2]], reach);
       return ccd(d0, reach,
                  VertexFaceQuery{x0[i], b0[t[0]], b0[t[1]], b0[t[2]], x1[i], b1[t[0]], b1[t[1]],
                                  b1[t[2]]});
@@ -843,10 +800,8 @@ struct ContactHandler::Impl {
       if (body_vertex_cloth_face_tangled(u, f)) return Outcome{-2.0, 0.0};
       const Face& t = cf[f];
       const double reach = move_b[u] + std::max({move_c[t[0]], move_c[t[1]], move_c[t[2]]}) + sep;
-      if (point_triangle_distance_lower_bound(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]) > reach) {
-        return Outcome{};
-      }
-      const double d0 = point_triangle_proximity(b0[u], x0[t[0]], x0[t[1]], x0[t[2]]).distance;
+      const double d0 =
+          point_triangle_distance_if_within(b0[u], x0[t[0]], x0[t[1]], x0[t[2]], reach);
       return ccd(d0, reach,
                  VertexFaceQuery{b0[u], x0[t[0]], x0[t[1]], x0[t[2]], b1[u], x1[t[0]], x1[t[1]],
                                  x1[t[2]]});
@@ -857,10 +812,7 @@ struct ContactHandler::Impl {
       const Edge& y = be[b];
       const double reach =
           std::max(move_c[x[0]], move_c[x[1]]) + std::max(move_b[y[0]], move_b[y[1]]) + sep;
-      if (edge_edge_distance_lower_bound(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]]) > reach) {
-        return Outcome{};
-      }
-      const double d0 = edge_edge_proximity(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]]).distance;
+      const double d0 = edge_edge_distance_if_within(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], reach);
       return ccd(d0, reach,
                  EdgeEdgeQuery{x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], x1[x[0]], x1[x[1]], b1[y[0]],
                                b1[y[1]]});
@@ -892,23 +844,6 @@ struct ContactHandler::Impl {
         keep(c, t_ee[i], make_ee(c, ee[i].first, false, ee[i].second, true, t_ee[i].toi, v));
       }
     }
-  }
-
-  // Scope flags of a restricted pass (all set when `active` is null).
-  void set_flags(const std::vector<int>* active) {
-    const Topology& t = model.topology();
-    if (active == nullptr) {
-      vertex_flag.assign(t.num_vertices(), 1);
-      face_flag.assign(t.num_faces(), 1);
-      edge_flag.assign(t.num_edges(), 1);
-      return;
-    }
-    vertex_flag.assign(t.num_vertices(), 0);
-    for (int i : *active)
-      vertex_flag[i] = 1;
-    face_flag = t.faces_touching(vertex_flag);
-    edge_flag = t.edges_touching(vertex_flag);
-    node_flag = cloth_bvh.nodes_holding(face_flag);
   }
 
   // Escaping vertices (find_escapes()) move out of the body, relative to the face they are

@@ -188,7 +188,8 @@ TEST(CcdProximity, DegenerateCases) {
   EXPECT_THROW((void)point_triangle_proximity(o, o, V(0, INFINITY, 0), x), std::invalid_argument);
 }
 
-// The lower bounds never exceed the exact distance, on random features at the unit scale and at a
+// The lower bounds never exceed the exact distance, and the *_if_within forms give it exactly
+// up to their limit, on random features at the unit scale and at a
 // cloth's (millimetre features 1 m from the origin), and on near-degenerate ones: slivers,
 // near-parallel edges, points close to a triangle's plane.
 TEST(CcdProximity, LowerBoundsNeverExceedTheDistance) {
@@ -222,6 +223,23 @@ TEST(CcdProximity, LowerBoundsNeverExceedTheDistance) {
       EXPECT_LE(lee, ee) << size << " " << i;
       EXPECT_GE(lee, 0.0);
       positive += (lpt > 0) + (lee > 0);
+      // The *_if_within forms: the exact distance (bit for bit) up to the limit, above it after.
+      for (const double limit : {0.0, 0.5 * pt, pt, 2 * pt, lpt}) {
+        const double got = point_triangle_distance_if_within(p, a, b, c, limit);
+        if (pt <= limit) {
+          EXPECT_EQ(got, pt) << size << " " << i;
+        } else {
+          EXPECT_GT(got, limit) << size << " " << i;
+        }
+      }
+      for (const double limit : {0.0, 0.5 * ee, ee, 2 * ee, lee}) {
+        const double got = edge_edge_distance_if_within(p, a, c, d, limit);
+        if (ee <= limit) {
+          EXPECT_EQ(got, ee) << size << " " << i;
+        } else {
+          EXPECT_GT(got, limit) << size << " " << i;
+        }
+      }
     }
   }
   EXPECT_GT(positive, 30000);  // the bounds cull: most random pairs get a positive one
@@ -242,6 +260,10 @@ TEST(CcdProximity, LowerBoundsAreTightWhereTheyShouldBe) {
   EXPECT_EQ(point_triangle_distance_lower_bound(V(0.25, 0.25, 0), o, x, y), 0.0);
   EXPECT_EQ(edge_edge_distance_lower_bound(o, x, V(0.5, -1, 0), V(0.5, 1, 0)), 0.0);
   EXPECT_THROW((void)point_triangle_distance_lower_bound(V(NAN, 0, 0), o, x, y),
+               std::invalid_argument);
+  EXPECT_THROW((void)point_triangle_distance_if_within(V(NAN, 0, 0), o, x, y, 1.0),
+               std::invalid_argument);
+  EXPECT_THROW((void)edge_edge_distance_if_within(o, x, V(0, INFINITY, 0), y, 1.0),
                std::invalid_argument);
   EXPECT_THROW((void)edge_edge_distance_lower_bound(o, x, V(0, INFINITY, 0), y),
                std::invalid_argument);

@@ -16,7 +16,7 @@ namespace clothcd::sim {
 namespace {
 
 using detail::BodyPairs;
-using detail::FeatureBoxes;
+using detail::BoxList;
 using detail::PairSide;
 
 // One mesh with its topology, BVH and feature boxes over x0 -> x1.
@@ -24,7 +24,7 @@ struct Mesh {
   Topology topo;
   std::vector<Vec3> x0, x1;
   Bvh bvh;
-  FeatureBoxes v, e, f;
+  detail::MeshBoxes boxes;
   std::vector<int> vface, eface;
 
   Mesh(const ClothMeshInput& in, std::mt19937_64& rng, double jitter, const Vec3& motion)
@@ -46,32 +46,17 @@ struct Mesh {
     } else {
       bvh.refit(x0, ro);
     }
-    const std::vector<Vec3>& b = swept ? x1 : x0;
-    auto fill = [&](auto&& ids, int count, FeatureBoxes& out) {
-      out.resize(count);
-      for (int k = 0; k < count; ++k) {
-        Vec3 lo = Vec3::Constant(INFINITY), hi = -lo;
-        for (int i : ids(k)) {
-          lo = lo.cwiseMin(x0[i]).cwiseMin(b[i]);
-          hi = hi.cwiseMax(x0[i]).cwiseMax(b[i]);
-        }
-        out.lo[k] = lo;
-        out.hi[k] = hi;
-      }
-    };
-    fill([](int k) { return std::array<int, 1>{k}; }, topo.num_vertices(), v);
-    fill([&](int k) { return topo.edges()[k]; }, topo.num_edges(), e);
-    fill([&](int k) { return topo.faces()[k]; }, topo.num_faces(), f);
+    detail::fill_feature_boxes(topo, x0, swept ? x1 : x0, {}, {}, {}, boxes);
   }
 
   [[nodiscard]] PairSide side(std::span<const std::uint8_t> vuse = {},
                               std::span<const std::uint8_t> euse = {},
                               std::span<const std::uint8_t> fuse = {}) const {
-    return {&topo, &bvh, &v, &e, &f, vface, eface, vuse, euse, fuse};
+    return {&topo, &bvh, &boxes, vface, eface, vuse, euse, fuse};
   }
 };
 
-bool near(const FeatureBoxes& a, int i, const FeatureBoxes& b, int j, double gap) {
+bool near(const BoxList& a, int i, const BoxList& b, int j, double gap) {
   return (a.lo[i].array() <= b.hi[j].array() + gap).all() &&
          (b.lo[j].array() <= a.hi[i].array() + gap).all();
 }
@@ -85,17 +70,19 @@ BodyPairs brute_force(const Mesh& c, const Mesh& b, double gap, std::span<const 
   BodyPairs out;
   for (int i = 0; i < c.topo.num_vertices(); ++i) {
     for (int g = 0; g < b.topo.num_faces(); ++g) {
-      if (used(vuse, i) && near(c.v, i, b.f, g, gap)) out.vf_cb.emplace_back(i, g);
+      if (used(vuse, i) && near(c.boxes.vertex, i, b.boxes.face, g, gap))
+        out.vf_cb.emplace_back(i, g);
     }
   }
   for (int u = 0; u < b.topo.num_vertices(); ++u) {
     for (int f = 0; f < c.topo.num_faces(); ++f) {
-      if (used(fuse, f) && near(b.v, u, c.f, f, gap)) out.vf_bc.emplace_back(u, f);
+      if (used(fuse, f) && near(b.boxes.vertex, u, c.boxes.face, f, gap))
+        out.vf_bc.emplace_back(u, f);
     }
   }
   for (int a = 0; a < c.topo.num_edges(); ++a) {
     for (int e = 0; e < b.topo.num_edges(); ++e) {
-      if (used(euse, a) && near(c.e, a, b.e, e, gap)) out.ee.emplace_back(a, e);
+      if (used(euse, a) && near(c.boxes.edge, a, b.boxes.edge, e, gap)) out.ee.emplace_back(a, e);
     }
   }
   return out;  // loops in order: already sorted
@@ -164,6 +151,43 @@ TEST(BodyPairs, UseFlagsAndNodeRestrictionMatchBruteForce) {
   expect_same(got, want);
   EXPECT_FALSE(want.vf_cb.empty());
   EXPECT_FALSE(want.ee.empty());
+}
+
+TEST(BodyPairs, FeatureBoxesAreTheBoxesOfBothPositionsWhereUsed) {
+  Scene s;
+  const Mesh& m = s.cloth;
+  const Topology& t = m.topo;
+  detail::MeshBoxes boxes;
+  detail::fill_feature_boxes(t, m.x0, m.x1, {}, {}, {}, boxes);
+  auto expect_box = [&](const detail::BoxList& b, int k, std::initializer_list<int> ids) {
+    Vec3 lo = Vec3::Constant(INFINITY), hi = -lo;
+    for (int i : ids) {
+      lo = lo.cwiseMin(m.x0[i]).cwiseMin(m.x1[i]);
+      hi = hi.cwiseMax(m.x0[i]).cwiseMax(m.x1[i]);
+    }
+    EXPECT_EQ(b.lo[k], lo) << k;
+    EXPECT_EQ(b.hi[k], hi) << k;
+  };
+  for (int v = 0; v < t.num_vertices(); ++v)
+    expect_box(boxes.vertex, v, {v});
+  for (int e = 0; e < t.num_edges(); ++e)
+    expect_box(boxes.edge, e, {t.edges()[e][0], t.edges()[e][1]});
+  for (int f = 0; f < t.num_faces(); ++f)
+    expect_box(boxes.face, f, {t.faces()[f][0], t.faces()[f][1], t.faces()[f][2]});
+  // With use flags only the used features change: the rest keep the static boxes of x0.
+  detail::MeshBoxes kept;
+  detail::fill_feature_boxes(t, m.x0, m.x0, {}, {}, {}, kept);
+  std::vector<std::uint8_t> vuse(t.num_vertices(), 0), euse(t.num_edges(), 0);
+  std::vector<std::uint8_t> fuse(t.num_faces(), 0);
+  vuse[3] = euse[5] = fuse[7] = 1;
+  const detail::MeshBoxes before = kept;
+  detail::fill_feature_boxes(t, m.x0, m.x1, vuse, euse, fuse, kept);
+  for (int v = 0; v < t.num_vertices(); ++v)
+    EXPECT_EQ(kept.vertex.lo[v], (v == 3 ? boxes : before).vertex.lo[v]) << v;
+  for (int e = 0; e < t.num_edges(); ++e)
+    EXPECT_EQ(kept.edge.hi[e], (e == 5 ? boxes : before).edge.hi[e]) << e;
+  for (int f = 0; f < t.num_faces(); ++f)
+    EXPECT_EQ(kept.face.lo[f], (f == 7 ? boxes : before).face.lo[f]) << f;
 }
 
 TEST(BodyPairs, SameListsForOneAndTwoThreads) {

@@ -49,6 +49,19 @@ struct EdgeEdgeProximity {
                                                     const Eigen::Vector3d& eb0,
                                                     const Eigen::Vector3d& eb1);
 
+/// The exact distance where it is at most `limit`; elsewhere some value above `limit` (the lower
+/// bound, when that already exceeds `limit`: the exact query is then skipped). For callers that
+/// only compare the distance with a limit. Finite input is required (std::invalid_argument
+/// otherwise).
+[[nodiscard]] double point_triangle_distance_if_within(const Eigen::Vector3d& p,
+                                                       const Eigen::Vector3d& f0,
+                                                       const Eigen::Vector3d& f1,
+                                                       const Eigen::Vector3d& f2, double limit);
+[[nodiscard]] double edge_edge_distance_if_within(const Eigen::Vector3d& ea0,
+                                                  const Eigen::Vector3d& ea1,
+                                                  const Eigen::Vector3d& eb0,
+                                                  const Eigen::Vector3d& eb1, double limit);
+
 /// Closest point parameter of p on segment ab, in [0, 1] (0 for a zero-length segment).
 [[nodiscard]] double point_segment_parameter(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                              const Eigen::Vector3d& b);
