@@ -41,12 +41,17 @@ void CouplingTerms::reset(std::span<const ContactCoupling> couplings,
   }
   for (int i = 0; i < n; ++i)
     start_[i + 1] += start_[i];
-  entries_.assign(start_[n], 0);
+  entry_coupling_.assign(start_[n], 0);
+  entry_weight_.assign(start_[n], 0.0);
   std::vector<int> fill(start_.begin(), start_.end() - 1);
+  normal_.resize(list_.size());
   for (int j = 0; j < static_cast<int>(list_.size()); ++j) {
+    normal_[j] = list_[j].n;
     for (int k = 0; k < 4; ++k) {
       const int i = list_[j].vertex[k];
-      if (i >= 0) entries_[fill[i]++] = j * 4 + k;
+      if (i < 0) continue;
+      entry_coupling_[fill[i]] = j;
+      entry_weight_[fill[i]++] = list_[j].c[k];
     }
   }
 }
@@ -65,17 +70,12 @@ double CouplingTerms::gap_rate(int j, const Vecs& v, const Vecs* dv) const {
 void CouplingTerms::scatter(const std::vector<double>& s, Vecs& y) const {
   const int n = static_cast<int>(start_.size()) - 1;
   tbb::parallel_for(tbb::blocked_range<int>(0, n, kGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i < r.end(); ++i) {
-      for (int e = start_[i]; e < start_[i + 1]; ++e) {
-        const int j = entries_[e] / 4, k = entries_[e] % 4;
-        if (s[j] != 0.0) y[i] += (list_[j].c[k] * s[j]) * list_[j].n;
-      }
-    }
+    for (int i = r.begin(); i < r.end(); ++i)
+      add_entries(s, i, y[i]);
   });
 }
 
-void CouplingTerms::add_product(const Vecs& x, Vecs& y) const {
-  if (list_.empty()) return;
+void CouplingTerms::gather(const Vecs& x) const {
   const int m = size();
   scratch_.resize(m);
   tbb::parallel_for(tbb::blocked_range<int>(0, m, kGrain), [&](const tbb::blocked_range<int>& r) {
@@ -92,15 +92,20 @@ void CouplingTerms::add_product(const Vecs& x, Vecs& y) const {
       scratch_[j] = kappa_[j] * c.n.dot(sum);
     }
   });
+}
+
+void CouplingTerms::add_product(const Vecs& x, Vecs& y) const {
+  if (list_.empty()) return;
+  gather(x);
   scatter(scratch_, y);
 }
 
 void CouplingTerms::add_diagonal(int i, Mat3& d) const {
   for (int e = start_[i]; e < start_[i + 1]; ++e) {
-    const int j = entries_[e] / 4, k = entries_[e] % 4;
+    const int j = entry_coupling_[e];
     if (kappa_[j] == 0.0) continue;
-    const ContactCoupling& c = list_[j];
-    d += (kappa_[j] * c.c[k] * c.c[k]) * (c.n * c.n.transpose());
+    const double w = entry_weight_[e];
+    d += (kappa_[j] * w * w) * (normal_[j] * normal_[j].transpose());
   }
 }
 

@@ -23,6 +23,11 @@ class CouplingTerms {
 
   /// y += sum over active j of kappa_j c_jk n_j (n_j . sum_k c_jk x_k).
   void add_product(const Vecs& x, Vecs& y) const;
+  /// add_product in two halves, for a caller that fuses the second into its own pass over the
+  /// vertices: gather(x) keeps kappa_j n_j . sum_k c_jk x_k per coupling, then add_gathered(i, y_i)
+  /// does vertex i's share of the sum (the same operations in the same order as add_product).
+  void gather(const Vecs& x) const;
+  void add_gathered(int i, Vec3& y) const { add_entries(scratch_, i, y); }
   /// d += the active couplings' block on vertex i's diagonal.
   void add_diagonal(int i, Mat3& d) const;
   /// b -= sum over active j of kappa_j c_jk n_j g_j, with g_j the coupling's relative normal
@@ -36,11 +41,21 @@ class CouplingTerms {
   [[nodiscard]] double gap_rate(int j, const Vecs& v, const Vecs* dv) const;
   /// y_i += sum over i's entries (j, k) of c_jk s_j n_j, per vertex in a fixed order.
   void scatter(const std::vector<double>& s, Vecs& y) const;
+  void add_entries(const std::vector<double>& s, int i, Vec3& y) const {
+    for (int e = start_[i]; e < start_[i + 1]; ++e) {
+      const int j = entry_coupling_[e];
+      if (s[j] != 0.0) y += (entry_weight_[e] * s[j]) * normal_[j];
+    }
+  }
 
   std::vector<ContactCoupling> list_;
-  std::vector<double> kappa_;            // 0 once let go
-  std::vector<int> start_;               // per vertex: range into entries_
-  std::vector<int> entries_;             // coupling * 4 + k
+  std::vector<double> kappa_;  // 0 once let go
+  // Per vertex a range of entries, each a coupling j and the vertex's weight c_jk in it, and per
+  // coupling its normal: compact copies of list_ for the product's inner loop.
+  std::vector<int> start_;
+  std::vector<int> entry_coupling_;
+  std::vector<double> entry_weight_;
+  std::vector<Vec3> normal_;
   mutable std::vector<double> scratch_;  // per coupling, reused by every product of the solve
 };
 

@@ -31,10 +31,16 @@ double dot(const Vecs& a, const Vecs& b) {
 }  // namespace
 
 void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x, Vecs& y,
-                  const CouplingTerms* couplings) {
-  multiply(h, x, y);
-  for_each_vertex(static_cast<int>(x.size()), [&](int i) { y[i] = mass[i] * x[i] + c * y[i]; });
-  if (couplings != nullptr) couplings->add_product(x, y);
+                  const CouplingTerms* couplings, const VertexFilter* filter) {
+  // One pass over the rows; per row the operations of multiply, the mass term, the couplings'
+  // scatter and the filter in that order, so the bits are those of four separate passes.
+  if (couplings != nullptr && couplings->empty()) couplings = nullptr;
+  if (couplings != nullptr) couplings->gather(x);
+  for_each_vertex(static_cast<int>(x.size()), [&](int i) {
+    Vec3 yi = mass[i] * x[i] + c * row_product(h, x, i);
+    if (couplings != nullptr) couplings->add_gathered(i, yi);
+    y[i] = filter != nullptr ? filter->apply(i, yi) : yi;
+  });
 }
 
 PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
@@ -66,8 +72,7 @@ PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
     return result;
   }
   for (int it = 0; it < options.max_iterations; ++it) {
-    apply_system(h, c, mass, p, q, couplings);
-    for_each_vertex(n, [&](int i) { q[i] = filter.apply(i, q[i]); });
+    apply_system(h, c, mass, p, q, couplings, &filter);
     const double pq = dot(p, q);
     if (!(pq > 0.0)) break;  // breakdown: PSD matrix and nonzero p make this impossible in theory
     const double alpha = delta / pq;

@@ -43,10 +43,10 @@ struct PcgResult {
   bool converged = false;
 };
 
-/// y = (diag(mass) + c H + K) x, the system solve_pcg solves; K: the active couplings' penalties
-/// (none when `couplings` is null).
+/// y = S (diag(mass) + c H + K) x, the system solve_pcg solves; K: the active couplings'
+/// penalties (none when `couplings` is null), S: the filter (identity when `filter` is null).
 void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x, Vecs& y,
-                  const CouplingTerms* couplings = nullptr);
+                  const CouplingTerms* couplings = nullptr, const VertexFilter* filter = nullptr);
 
 /// Solves (diag(mass) + c H + K) dv = b. dv holds the start on entry: its constrained components
 /// must already be the prescribed changes; the free ones are a warm start.

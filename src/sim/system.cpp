@@ -213,17 +213,8 @@ double SystemAssembler::elastic_energy(std::span<const Vec3> x) const {
 void multiply(const BlockCsr& a, std::span<const Vec3> x, std::span<Vec3> y) {
   tbb::parallel_for(tbb::blocked_range<int>(0, a.rows(), kGrain),
                     [&](const tbb::blocked_range<int>& r) {
-                      for (int i = r.begin(); i < r.end(); ++i) {
-                        Vec3 s = Vec3::Zero();
-                        for (int q = a.row_start[i]; q < a.row_start[i + 1]; ++q) {
-                          s += a.values[q] * x[a.cols[q]];
-                        }
-                        if (!a.scalar_row_start.empty()) {
-                          for (int q = a.scalar_row_start[i]; q < a.scalar_row_start[i + 1]; ++q)
-                            s += a.scalar_values[q] * x[a.scalar_cols[q]];
-                        }
-                        y[i] = s;
-                      }
+                      for (int i = r.begin(); i < r.end(); ++i)
+                        y[i] = row_product(a, x, i);
                     });
 }
 

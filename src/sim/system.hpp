@@ -62,8 +62,19 @@ class SystemAssembler {
   std::vector<double> face_stretch_;
 };
 
-/// y = A x for a block matrix (parallel over rows): per row the full blocks in column order,
-/// then the scalar ones.
+/// (A x)_i: the full blocks of row i in column order, then the scalar ones.
+inline Vec3 row_product(const BlockCsr& a, std::span<const Vec3> x, int i) {
+  Vec3 s = Vec3::Zero();
+  for (int q = a.row_start[i]; q < a.row_start[i + 1]; ++q)
+    s += a.values[q] * x[a.cols[q]];
+  if (!a.scalar_row_start.empty()) {
+    for (int q = a.scalar_row_start[i]; q < a.scalar_row_start[i + 1]; ++q)
+      s += a.scalar_values[q] * x[a.scalar_cols[q]];
+  }
+  return s;
+}
+
+/// y = A x for a block matrix (parallel over rows, each row as row_product).
 void multiply(const BlockCsr& a, std::span<const Vec3> x, std::span<Vec3> y);
 
 /// Sum over i of f(i) with a split tree fixed by n alone: bitwise equal for any thread count.

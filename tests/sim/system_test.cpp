@@ -1,6 +1,6 @@
 // The implicit system's matrix: its product against one summed element by element (membrane
 // blocks of every face, bending of every hinge, stitches), with the constant identity blocks
-// kept as scalars.
+// kept as scalars; and the solve's one-pass product with couplings and filters.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,6 +12,8 @@
 
 #include "clothcd/sim/elements.hpp"
 #include "grid.hpp"
+#include "sim/couplings.hpp"
+#include "sim/pcg.hpp"
 #include "sim/system.hpp"
 
 namespace clothcd::sim {
@@ -114,6 +116,82 @@ TEST(SystemAssembler, ProductMatchesTheElementsWithIdentityBlocksAsScalars) {
     ASSERT_GT(scale, 0.0);
     for (int i = 0; i < m.num_vertices(); ++i)
       EXPECT_LE((y[i] - want[i]).norm(), 1e-12 * scale) << "vertex " << i;
+  }
+}
+
+// The solve's product in one pass over the rows is the four passes it replaces, bit for bit, and
+// its coupling part is the penalty's definition: kappa_j c_jk n_j (n_j . sum_k c_jk x_k) with
+// kappa_j = scale / sum_k c_jk^2 / m_k.
+TEST(SystemProduct, OnePassIsTheSeparatePassesBitForBit) {
+  const ClothModel m(grid_cloth(10, 10, 0.2, 0.2), ClothMaterial{});
+  const int n = m.num_vertices();
+  std::mt19937_64 rng(11);
+  std::vector<Vec3> x = m.initial_positions();
+  for (Vec3& p : x)
+    p += random_vec(rng, 0.005);
+  SystemAssembler assembler(m);
+  BlockCsr h = assembler.make_matrix();
+  Vecs gradient;
+  assembler.assemble(x, h, gradient);
+  std::vector<double> mass(m.mass().begin(), m.mass().end()), inverse_mass(n);
+  for (int i = 0; i < n; ++i)
+    inverse_mass[i] = 1.0 / mass[i];
+  inverse_mass[5] = 0.0;  // a pinned vertex inside a coupling
+  // Vertex-face couplings between random vertices and faces, some with a body point (-1).
+  std::vector<ContactCoupling> list;
+  std::uniform_int_distribution<int> pick_v(0, n - 1), pick_f(0, m.topology().num_faces() - 1);
+  for (int j = 0; j < 60; ++j) {
+    ContactCoupling c;
+    const Face& f = m.topology().faces()[pick_f(rng)];
+    c.vertex = {j % 7 == 0 ? 5 : pick_v(rng), f[0], f[1], j % 5 == 0 ? -1 : f[2]};
+    c.c = {1.0, -0.2, -0.5, -0.3};
+    c.n = random_vec(rng, 1.0);
+    list.push_back(c);
+  }
+  CouplingTerms k;
+  k.reset(list, inverse_mass, 100.0);
+  ASSERT_EQ(k.size(), 60);
+  VertexFilter filter;
+  filter.reset(n);
+  for (int i = 0; i < n; i += 3) {
+    filter.kind[i] = i % 2 == 0 ? VertexFilter::Plane : VertexFilter::Pinned;
+    filter.direction[i] = random_vec(rng, 1.0).normalized();
+  }
+  const double c = 2.5e-5;
+  for (int trial = 0; trial < 3; ++trial) {
+    Vecs r(n), separate(n), hr(n), fused(n), unfiltered(n);
+    for (Vec3& v : r)
+      v = random_vec(rng, 1.0);
+    multiply(h, r, hr);
+    for (int i = 0; i < n; ++i)
+      separate[i] = mass[i] * r[i] + c * hr[i];
+    k.add_product(r, separate);
+    apply_system(h, c, mass, r, unfiltered, &k);
+    apply_system(h, c, mass, r, fused, &k, &filter);
+    double scale = 0.0;
+    for (int i = 0; i < n; ++i) {
+      scale = std::max(scale, separate[i].norm());
+      ASSERT_EQ(unfiltered[i], separate[i]) << "vertex " << i;
+      ASSERT_EQ(fused[i], filter.apply(i, separate[i])) << "vertex " << i;
+    }
+    // The coupling part against its definition.
+    Vecs want(n);
+    for (int i = 0; i < n; ++i)
+      want[i] = mass[i] * r[i] + c * hr[i];
+    for (const ContactCoupling& cp : list) {
+      const Vec3 nn = cp.n.normalized();
+      double w = 0.0, g = 0.0;
+      for (int a = 0; a < 4; ++a) {
+        if (cp.vertex[a] < 0) continue;
+        w += cp.c[a] * cp.c[a] * inverse_mass[cp.vertex[a]];
+        g += cp.c[a] * nn.dot(r[cp.vertex[a]]);
+      }
+      for (int a = 0; a < 4; ++a) {
+        if (cp.vertex[a] >= 0) want[cp.vertex[a]] += (100.0 / w) * cp.c[a] * g * nn;
+      }
+    }
+    for (int i = 0; i < n; ++i)
+      EXPECT_LE((unfiltered[i] - want[i]).norm(), 1e-12 * scale) << "vertex " << i;
   }
 }
 
