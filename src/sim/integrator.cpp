@@ -169,13 +169,17 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
   if (ct != nullptr) ct->add_rhs(state.v, rhs);
   const PcgOptions pcg{options_.pcg_max_iterations, options_.pcg_tolerance};
   const double c = h * (h + beta);
-  PcgResult res = solve_pcg(im.h, c, mass, rhs, im.filter, pcg, dv, ct);
+  PcgOptions first = pcg;
+  if (!im.constraints.empty() || ct != nullptr)
+    first.tolerance = std::max(pcg.tolerance, options_.release_tolerance);
+  PcgResult res = solve_pcg(im.h, c, mass, rhs, im.filter, first, dv, ct);
   ++stats.solves;
   stats.pcg_iterations += res.iterations;
   stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);
   // A constraint whose force would pull its vertex onto the body, and a coupling that would hold
   // its pair together, are let go, and the solve redone from where it stopped (Baraff & Witkin
-  // 1998 release the next step; here the same one).
+  // 1998 release the next step; here the same one). The redo also completes a first solve that
+  // stopped at release_tolerance.
   if ((!im.constraints.empty() || ct != nullptr) && std::isfinite(res.relative_residual)) {
     Vecs q(n);
     apply_system(im.h, c, mass, dv, q, ct);
@@ -193,7 +197,7 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
       rhs = im.b;
       ct->add_rhs(state.v, rhs);
     }
-    if (released) {
+    if (released || res.relative_residual > pcg.tolerance) {
       res = solve_pcg(im.h, c, mass, rhs, im.filter, pcg, dv, ct);
       stats.pcg_iterations += res.iterations;
       stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);

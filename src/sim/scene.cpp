@@ -327,6 +327,8 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     ObjectReader o = top.object("solver");
     s.solver.pcg_max_iterations = o.integer("pcg_max_iterations", s.solver.pcg_max_iterations, 1);
     s.solver.pcg_tolerance = o.number("pcg_tolerance", s.solver.pcg_tolerance, 0.0, 1.0);
+    s.solver.release_tolerance =
+        o.number("release_tolerance", s.solver.release_tolerance, 0.0, 1.0);
     s.solver.halve_residual = o.number("halve_residual", s.solver.halve_residual, 0.0, INFINITY);
     s.solver.max_halvings = o.integer("max_halvings", s.solver.max_halvings, 0, 10);
     s.solver.halve_unresolved = o.boolean("halve_unresolved", s.solver.halve_unresolved);

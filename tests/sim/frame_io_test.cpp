@@ -141,6 +141,7 @@ TEST(FrameIo, ResumeMatchesStraightRunBitwise) {
   EXPECT_EQ(manifest["solver"]["max_halvings"], scene.solver.max_halvings);
   EXPECT_EQ(manifest["solver"]["halve_unresolved"], scene.solver.halve_unresolved);
   EXPECT_EQ(manifest["solver"]["pcg_tolerance"], scene.solver.pcg_tolerance);
+  EXPECT_EQ(manifest["solver"]["release_tolerance"], scene.solver.release_tolerance);
   // Resuming a finished run does nothing.
   Simulation sim(test_scene());
   RunOptions opt;

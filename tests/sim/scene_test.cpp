@@ -58,6 +58,15 @@ TEST(Scene, UnresolvedHitsHalveTheSubstepUnlessTheSceneSaysNot) {
   EXPECT_FALSE(parse_scene(j, "test-scene.json").solver.halve_unresolved);
 }
 
+TEST(Scene, FirstSolveStopsAtTheReleaseToleranceTheSceneGives) {
+  json j = small_grid_scene();
+  EXPECT_EQ(parse_scene(j, "test-scene.json").solver.release_tolerance, 1e-2);
+  j["solver"] = {{"release_tolerance", 1e-3}};
+  EXPECT_EQ(parse_scene(j, "test-scene.json").solver.release_tolerance, 1e-3);
+  j["solver"] = {{"release_tolerance", 2.0}};
+  EXPECT_THROW((void)parse_scene(j, "test-scene.json"), InputError);
+}
+
 TEST(Scene, RepulsionIsPointwiseAndContactsEnterTheSolveUnlessTheSceneSaysNot) {
   json j = small_grid_scene();
   const Scene on = parse_scene(j, "test-scene.json");
