@@ -197,7 +197,7 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
       rhs = im.b;
       ct->add_rhs(state.v, rhs);
     }
-    if (released || res.relative_residual > pcg.tolerance) {
+    if (released || (first.tolerance > pcg.tolerance && res.relative_residual > pcg.tolerance)) {
       res = solve_pcg(im.h, c, mass, rhs, im.filter, pcg, dv, ct);
       stats.pcg_iterations += res.iterations;
       stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);

@@ -361,7 +361,9 @@ TEST(Integrator, FirstSolveStoppedAtTheReleaseToleranceEndsWhereTheCompleteOneDo
     EXPECT_TRUE(complete.converged);
     EXPECT_EQ(loose.solves, 1);  // one attempt: no halving
     EXPECT_NEAR(a.v[24].y(), 0.0, 1e-12);
-    if (corner) EXPECT_LT(a.v[0].y(), -1e-3);  // let go: it falls
+    if (corner) {
+      EXPECT_LT(a.v[0].y(), -1e-3);  // let go: it falls
+    }
     double scale = 0.0;
     for (int i = 0; i < m.num_vertices(); ++i)
       scale = std::max(scale, b.v[i].norm());

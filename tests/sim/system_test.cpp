@@ -22,6 +22,22 @@ namespace {
 using test::grid_cloth;
 using test::random_vec;
 
+// The system matrix at the model's initial shape crumpled by up to 5 mm.
+struct Crumpled {
+  std::vector<Vec3> x;
+  BlockCsr h;
+};
+Crumpled crumpled_system(const ClothModel& m, std::mt19937_64& rng) {
+  Crumpled c{m.initial_positions(), {}};
+  for (Vec3& p : c.x)
+    p += random_vec(rng, 0.005);
+  SystemAssembler assembler(m);
+  c.h = assembler.make_matrix();
+  Vecs gradient;
+  assembler.assemble(c.x, c.h, gradient);
+  return c;
+}
+
 // H r with H = membrane (PSD-projected, at x) + bending + stitches, element by element.
 std::vector<Vec3> reference_product(const ClothModel& m, const std::vector<Vec3>& x,
                                     const std::vector<Vec3>& r) {
@@ -68,14 +84,7 @@ TEST(SystemAssembler, ProductMatchesTheElementsWithIdentityBlocksAsScalars) {
   const ClothModel m(in, ClothMaterial{});
   ASSERT_GT(m.stitches().size(), 0u);
   std::mt19937_64 rng(3);
-  std::vector<Vec3> x = m.initial_positions();
-  for (Vec3& p : x)
-    p += random_vec(rng, 0.005);
-
-  SystemAssembler assembler(m);
-  BlockCsr h = assembler.make_matrix();
-  Vecs gradient;
-  assembler.assemble(x, h, gradient);
+  const auto [x, h] = crumpled_system(m, rng);
   // The scalar blocks are exactly the vertex pairs that a hinge or a stitch joins and no face
   // does; the diagonal is always a full block.
   std::set<std::pair<int, int>> in_face, expected_scalar, scalar;
@@ -126,13 +135,7 @@ TEST(SystemProduct, OnePassIsTheSeparatePassesBitForBit) {
   const ClothModel m(grid_cloth(10, 10, 0.2, 0.2), ClothMaterial{});
   const int n = m.num_vertices();
   std::mt19937_64 rng(11);
-  std::vector<Vec3> x = m.initial_positions();
-  for (Vec3& p : x)
-    p += random_vec(rng, 0.005);
-  SystemAssembler assembler(m);
-  BlockCsr h = assembler.make_matrix();
-  Vecs gradient;
-  assembler.assemble(x, h, gradient);
+  const BlockCsr h = crumpled_system(m, rng).h;
   std::vector<double> mass(m.mass().begin(), m.mass().end()), inverse_mass(n);
   for (int i = 0; i < n; ++i)
     inverse_mass[i] = 1.0 / mass[i];

@@ -39,7 +39,8 @@ struct SolverOptions {
   /// residual (or pcg_tolerance, if larger): it only decides which of them to let go, and the
   /// solve redone after that reaches pcg_tolerance. On multilayer-rumba frames 61-64 a complete
   /// first solve (73 iterations a substep) was followed by a redo of 43 in every substep; with
-  /// 1e-2 they took 18 and 64 (docs/simulator.md, "Measured").
+  /// 1e-2 they took 18 and 64 (docs/simulator.md, "Measured"). At or below pcg_tolerance: the
+  /// complete first solve, redone only when something was let go (as before session 14).
   double release_tolerance = 1e-2;
   /// A substep is halved (up to `max_halvings` times) when PCG ends above this relative residual
   /// or the result is not finite.
