@@ -36,6 +36,13 @@ class CouplingTerms {
   /// Lets go every active coupling whose pair separates faster than its target at v + dv (its
   /// penalty would hold the pair together); returns how many.
   int release_adhesive(const Vecs& v, const Vecs& dv);
+  /// f(coupling, kappa) for every active coupling, in order (normals unit).
+  template <typename F>
+  void for_each_active(F&& f) const {
+    for (std::size_t j = 0; j < list_.size(); ++j) {
+      if (kappa_[j] != 0.0) f(list_[j], kappa_[j]);
+    }
+  }
 
  private:
   [[nodiscard]] double gap_rate(int j, const Vecs& v, const Vecs* dv) const;

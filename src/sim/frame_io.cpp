@@ -287,6 +287,7 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
                  {{"pcg_max_iterations", scene.solver.pcg_max_iterations},
                   {"pcg_tolerance", scene.solver.pcg_tolerance},
                   {"release_tolerance", scene.solver.release_tolerance},
+                  {"coarse_aggregate", scene.solver.coarse_aggregate},
                   {"halve_residual", scene.solver.halve_residual},
                   {"max_halvings", scene.solver.max_halvings},
                   {"halve_unresolved", scene.solver.halve_unresolved}}},

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "clothcd/core/error.hpp"
@@ -48,6 +49,7 @@ struct ClothSolver::Impl {
   std::vector<Vec3> body_t0, body_t1;
   std::vector<ContactConstraint> constraints;
   CouplingTerms couplings;
+  std::optional<CoarseSpace> coarse;
 
   Vec3 pin_target(const PinnedVertex& p, double t) const {
     const PinGroup& g = groups[p.group];
@@ -67,6 +69,11 @@ ClothSolver::ClothSolver(const ClothModel& model, const SolverOptions& options)
     if (m <= 0.0) impl_->filter.kind[i] = VertexFilter::Pinned;
     impl_->inverse_mass[i] = m > 0.0 ? 1.0 / m : 0.0;
   }
+  if (options.coarse_aggregate == 1 || options.coarse_aggregate < 0) {
+    throw InputError(fmt::format("coarse_aggregate must be 0 (off) or at least 2, got {}",
+                                 options.coarse_aggregate));
+  }
+  if (options.coarse_aggregate > 0) impl_->coarse.emplace(impl_->h, options.coarse_aggregate);
 }
 
 ClothSolver::~ClothSolver() = default;
@@ -172,7 +179,12 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
   PcgOptions first = pcg;
   if (!im.constraints.empty() || ct != nullptr)
     first.tolerance = std::max(pcg.tolerance, options_.release_tolerance);
-  PcgResult res = solve_pcg(im.h, c, mass, rhs, im.filter, first, dv, ct);
+  const CoarseSpace* coarse = nullptr;
+  if (im.coarse) {
+    im.coarse->update(im.h, c, mass, ct);
+    coarse = &*im.coarse;
+  }
+  PcgResult res = solve_pcg(im.h, c, mass, rhs, im.filter, first, dv, ct, coarse);
   ++stats.solves;
   stats.pcg_iterations += res.iterations;
   stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);
@@ -198,7 +210,7 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
       ct->add_rhs(state.v, rhs);
     }
     if (released || (first.tolerance > pcg.tolerance && res.relative_residual > pcg.tolerance)) {
-      res = solve_pcg(im.h, c, mass, rhs, im.filter, pcg, dv, ct);
+      res = solve_pcg(im.h, c, mass, rhs, im.filter, pcg, dv, ct, coarse);
       stats.pcg_iterations += res.iterations;
       stats.max_pcg_iterations = std::max(stats.max_pcg_iterations, res.iterations);
     }

@@ -45,7 +45,7 @@ void apply_system(const BlockCsr& h, double c, std::span<const double> mass, con
 
 PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
                     std::span<const Vec3> b, const VertexFilter& filter, const PcgOptions& options,
-                    Vecs& dv, const CouplingTerms* couplings) {
+                    Vecs& dv, const CouplingTerms* couplings, const CoarseSpace* coarse) {
   const int n = static_cast<int>(b.size());
   std::vector<Mat3> pinv(n);
   for_each_vertex(n, [&](int i) {
@@ -59,16 +59,37 @@ PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
     r[i] = filter.apply(i, b[i] - q[i]);
     fb[i] = filter.apply(i, b[i]);
   });
-  for_each_vertex(n, [&](int i) { s[i] = pinv[i] * fb[i]; });
-  const double delta0 = dot(fb, s);
-  for_each_vertex(n, [&](int i) { p[i] = filter.apply(i, pinv[i] * r[i]); });
+  // With a coarse space: S (D^-1 + P A_c^-1 P^T) S, applied to an already filtered vector. The
+  // stopping rule then still measures the residual in the block-Jacobi norm (in `jr`), so that
+  // the coarse part, large on smooth residuals, does not loosen it.
+  std::vector<Vec3> zc;
+  Vecs jr;
+  auto two_level = [&](const Vecs& in, Vecs& out) {
+    coarse->solve(in, zc);
+    jr.resize(n);
+    for_each_vertex(n, [&](int i) {
+      jr[i] = filter.apply(i, pinv[i] * in[i]);
+      out[i] = jr[i] + filter.apply(i, zc[coarse->aggregate_of(i)]);
+    });
+    return dot(in, jr);
+  };
+  double delta0 = 0.0, measure = 0.0;
+  if (coarse != nullptr) {
+    delta0 = two_level(fb, s);
+    measure = two_level(r, p);
+  } else {
+    for_each_vertex(n, [&](int i) { s[i] = pinv[i] * fb[i]; });
+    delta0 = dot(fb, s);
+    for_each_vertex(n, [&](int i) { p[i] = filter.apply(i, pinv[i] * r[i]); });
+  }
   double delta = dot(r, p);
+  if (coarse == nullptr) measure = delta;
   PcgResult result;
   const double tol2 = options.tolerance * options.tolerance;
   auto rel = [&](double d) { return delta0 > 0.0 ? std::sqrt(std::max(d, 0.0) / delta0) : 0.0; };
-  if (delta0 <= 0.0 || delta <= tol2 * delta0) {
-    result.converged = std::isfinite(delta);
-    result.relative_residual = rel(delta);
+  if (delta0 <= 0.0 || measure <= tol2 * delta0) {
+    result.converged = std::isfinite(measure);
+    result.relative_residual = rel(measure);
     return result;
   }
   for (int it = 0; it < options.max_iterations; ++it) {
@@ -76,24 +97,33 @@ PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
     const double pq = dot(p, q);
     if (!(pq > 0.0)) break;  // breakdown: PSD matrix and nonzero p make this impossible in theory
     const double alpha = delta / pq;
-    for_each_vertex(n, [&](int i) {
-      dv[i] += alpha * p[i];
-      r[i] -= alpha * q[i];
-      s[i] = filter.apply(i, pinv[i] * r[i]);
-    });
+    if (coarse != nullptr) {
+      for_each_vertex(n, [&](int i) {
+        dv[i] += alpha * p[i];
+        r[i] -= alpha * q[i];
+      });
+      measure = two_level(r, s);
+    } else {
+      for_each_vertex(n, [&](int i) {
+        dv[i] += alpha * p[i];
+        r[i] -= alpha * q[i];
+        s[i] = filter.apply(i, pinv[i] * r[i]);
+      });
+    }
     const double delta_new = dot(r, s);
     result.iterations = it + 1;
     if (!std::isfinite(delta_new)) {
-      delta = delta_new;
+      delta = measure = delta_new;
       break;
     }
     const double beta = delta_new / delta;
     delta = delta_new;
-    if (delta <= tol2 * delta0) break;
+    if (coarse == nullptr) measure = delta;
+    if (measure <= tol2 * delta0) break;
     for_each_vertex(n, [&](int i) { p[i] = s[i] + beta * p[i]; });
   }
-  result.relative_residual = rel(delta);
-  result.converged = std::isfinite(delta) && delta <= tol2 * delta0;
+  result.relative_residual = rel(measure);
+  result.converged = std::isfinite(measure) && measure <= tol2 * delta0;
   return result;
 }
 

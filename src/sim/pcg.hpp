@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "coarse.hpp"
 #include "couplings.hpp"
 #include "system.hpp"
 
@@ -49,9 +50,11 @@ void apply_system(const BlockCsr& h, double c, std::span<const double> mass, con
                   const CouplingTerms* couplings = nullptr, const VertexFilter* filter = nullptr);
 
 /// Solves (diag(mass) + c H + K) dv = b. dv holds the start on entry: its constrained components
-/// must already be the prescribed changes; the free ones are a warm start.
+/// must already be the prescribed changes; the free ones are a warm start. `coarse` (updated for
+/// this h, c and mass) adds its correction to the block-Jacobi preconditioner.
 PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
                     std::span<const Vec3> b, const VertexFilter& filter, const PcgOptions& options,
-                    Vecs& dv, const CouplingTerms* couplings = nullptr);
+                    Vecs& dv, const CouplingTerms* couplings = nullptr,
+                    const CoarseSpace* coarse = nullptr);
 
 }  // namespace clothcd::sim

@@ -329,6 +329,10 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     s.solver.pcg_tolerance = o.number("pcg_tolerance", s.solver.pcg_tolerance, 0.0, 1.0);
     s.solver.release_tolerance =
         o.number("release_tolerance", s.solver.release_tolerance, 0.0, 1.0);
+    s.solver.coarse_aggregate = o.integer("coarse_aggregate", s.solver.coarse_aggregate, 0);
+    if (s.solver.coarse_aggregate == 1) {
+      o.fail(o.key("coarse_aggregate"), "expected 0 (off) or at least 2, got 1");
+    }
     s.solver.halve_residual = o.number("halve_residual", s.solver.halve_residual, 0.0, INFINITY);
     s.solver.max_halvings = o.integer("max_halvings", s.solver.max_halvings, 0, 10);
     s.solver.halve_unresolved = o.boolean("halve_unresolved", s.solver.halve_unresolved);

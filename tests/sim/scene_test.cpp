@@ -67,6 +67,17 @@ TEST(Scene, FirstSolveStopsAtTheReleaseToleranceTheSceneGives) {
   EXPECT_THROW((void)parse_scene(j, "test-scene.json"), InputError);
 }
 
+TEST(Scene, CoarseCorrectionIsOffUnlessTheSceneGivesAnAggregateSize) {
+  json j = small_grid_scene();
+  EXPECT_EQ(parse_scene(j, "test-scene.json").solver.coarse_aggregate, 0);
+  j["solver"] = {{"coarse_aggregate", 64}};
+  EXPECT_EQ(parse_scene(j, "test-scene.json").solver.coarse_aggregate, 64);
+  j["solver"] = {{"coarse_aggregate", -1}};
+  EXPECT_THROW((void)parse_scene(j, "test-scene.json"), InputError);
+  j["solver"] = {{"coarse_aggregate", 1}};  // one vertex per aggregate is block Jacobi again
+  EXPECT_THROW((void)parse_scene(j, "test-scene.json"), InputError);
+}
+
 TEST(Scene, RepulsionIsPointwiseAndContactsEnterTheSolveUnlessTheSceneSaysNot) {
   json j = small_grid_scene();
   const Scene on = parse_scene(j, "test-scene.json");

@@ -42,6 +42,9 @@ struct SolverOptions {
   /// 1e-2 they took 18 and 64 (docs/simulator.md, "Measured"). At or below pcg_tolerance: the
   /// complete first solve, redone only when something was let go (as before session 14).
   double release_tolerance = 1e-2;
+  /// Vertices per aggregate of the PCG's coarse correction (a two-level preconditioner: block
+  /// Jacobi plus one translation per aggregate, factored every substep); 0: block Jacobi alone.
+  int coarse_aggregate = 0;
   /// A substep is halved (up to `max_halvings` times) when PCG ends above this relative residual
   /// or the result is not finite.
   double halve_residual = 1e-2;
