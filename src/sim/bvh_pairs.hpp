@@ -107,4 +107,26 @@ void for_each_self_overlap(const Bvh& a, Fn&& fn) {
   }
 }
 
+/// Like for_each_self_overlap, in parallel: fn(f, g, local) with the calling thread's `Local`
+/// from `locals`, each internal node's pair of children one task. The calls come in no fixed
+/// order: callers merge and sort.
+template <class Local, class Fn>
+void for_each_self_overlap_parallel(const Bvh& a, tbb::enumerable_thread_specific<Local>& locals,
+                                    Fn&& fn) {
+  const auto& n = a.nodes();
+  std::vector<int> internal;
+  for (int k = 0; k < static_cast<int>(n.size()); ++k) {
+    if (!n[k].is_leaf()) internal.push_back(k);
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, internal.size(), 64),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      Local& local = locals.local();
+                      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                        const BvhNode& x = n[internal[k]];
+                        for_each_overlap_below(a, x.left, a, x.left + 1,
+                                               [&](int f, int g) { fn(f, g, local); });
+                      }
+                    });
+}
+
 }  // namespace clothcd::sim::detail

@@ -26,6 +26,16 @@ bool segment_crosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b,
   return (s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0);
 }
 
+// The pairs the threads found, sorted: the same list whatever the thread count.
+std::vector<std::pair<int, int>> merged(
+    const tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>>& found) {
+  std::vector<std::pair<int, int>> out;
+  for (const auto& local : found)
+    out.insert(out.end(), local.begin(), local.end());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace
 
 bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
@@ -76,14 +86,13 @@ std::vector<std::pair<int, int>> IntersectionCounter::self_pairs(std::span<const
   RefitOptions ro;
   ro.cones = false;
   im.cloth_bvh.refit(x, ro);
-  std::vector<std::pair<int, int>> out;
   const auto& faces = im.cloth.faces();
-  detail::for_each_self_overlap(im.cloth_bvh, [&](int f, int g) {
+  tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>> found;
+  detail::for_each_self_overlap_parallel(im.cloth_bvh, found, [&](int f, int g, auto& local) {
     if (im.skip_self(f, g)) return;
-    if (Impl::test(x, faces[f], x, faces[g])) out.emplace_back(std::min(f, g), std::max(f, g));
+    if (Impl::test(x, faces[f], x, faces[g])) local.emplace_back(std::min(f, g), std::max(f, g));
   });
-  std::sort(out.begin(), out.end());
-  return out;
+  return merged(found);
 }
 
 std::vector<std::pair<int, int>> IntersectionCounter::body_pairs(std::span<const Vec3> x,
@@ -105,11 +114,13 @@ std::vector<std::pair<int, int>> IntersectionCounter::body_pairs(std::span<const
   im.body_bvh.refit(body, ro);
   const auto& cf = im.cloth.faces();
   const auto& bf = im.body->faces();
-  detail::for_each_overlap(im.cloth_bvh, im.body_bvh, [&](int f, int g) {
-    if (Impl::test(x, cf[f], body, bf[g])) out.emplace_back(f, g);
-  });
-  std::sort(out.begin(), out.end());
-  return out;
+  tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>> found;
+  detail::for_each_overlap_parallel(im.cloth_bvh, im.body_bvh, found,
+                                    [&](int f, int g, auto& local) {
+                                      if (Impl::test(x, cf[f], body, bf[g]))
+                                        local.emplace_back(f, g);
+                                    });
+  return merged(found);
 }
 
 std::vector<std::pair<int, int>> IntersectionCounter::self_pairs_brute_force(
