@@ -90,26 +90,10 @@ void for_each_overlap_parallel(const Bvh& a, const Bvh& b,
                     });
 }
 
-/// Calls fn(f, g) once for every unordered pair of distinct leaves of `a` whose boxes overlap:
-/// for every internal node, the pairs across its two children.
-template <class Fn>
-void for_each_self_overlap(const Bvh& a, Fn&& fn) {
-  const auto& n = a.nodes();
-  if (n.empty()) return;
-  std::vector<int> stack{0};
-  while (!stack.empty()) {
-    const BvhNode& x = n[stack.back()];
-    stack.pop_back();
-    if (x.is_leaf()) continue;
-    stack.push_back(x.left);
-    stack.push_back(x.left + 1);
-    for_each_overlap_below(a, x.left, a, x.left + 1, fn);
-  }
-}
-
-/// Like for_each_self_overlap, in parallel: fn(f, g, local) with the calling thread's `Local`
-/// from `locals`, each internal node's pair of children one task. The calls come in no fixed
-/// order: callers merge and sort.
+/// Calls fn(f, g, local) once for every unordered pair of distinct leaves of `a` whose boxes
+/// overlap: for every internal node, the pairs across its two children, each node one task, with
+/// the calling thread's `Local` from `locals`. The calls come in no fixed order: callers merge
+/// and sort.
 template <class Local, class Fn>
 void for_each_self_overlap_parallel(const Bvh& a, tbb::enumerable_thread_specific<Local>& locals,
                                     Fn&& fn) {

@@ -5,12 +5,16 @@
 #include <cstdint>
 #include <unordered_map>
 
+#include <fmt/format.h>
+
 #include "clothcd/core/error.hpp"
 
 namespace clothcd::sim {
 
 CoarseSpace::CoarseSpace(const BlockCsr& h, int size) {
-  if (size < 2) throw InputError("coarse aggregates need at least 2 vertices");
+  if (size < 2) {
+    throw InputError(fmt::format("coarse aggregates need at least 2 vertices, got {}", size));
+  }
   const int n = h.rows();
   const bool scalars = !h.scalar_row_start.empty();
   auto for_neighbours = [&](int i, auto&& f) {

@@ -4,7 +4,7 @@
 // translation per aggregate, factored once per substep. Block Jacobi removes the error of high
 // frequency fast; the smooth error, which the stiff membrane spreads over many vertices, is what
 // makes a cold solve long. Off by default (`SolverOptions::coarse_aggregate`): on the garment
-// scenes' warm-started solves it saves 27-42% of the iterations but no time on 2 threads
+// scenes' warm-started solves it saves 20-41% of the iterations but no time on 2 threads
 // (docs/simulator.md, "Measured", session 15).
 
 #include <Eigen/SparseCholesky>

@@ -69,11 +69,8 @@ ClothSolver::ClothSolver(const ClothModel& model, const SolverOptions& options)
     if (m <= 0.0) impl_->filter.kind[i] = VertexFilter::Pinned;
     impl_->inverse_mass[i] = m > 0.0 ? 1.0 / m : 0.0;
   }
-  if (options.coarse_aggregate == 1 || options.coarse_aggregate < 0) {
-    throw InputError(fmt::format("coarse_aggregate must be 0 (off) or at least 2, got {}",
-                                 options.coarse_aggregate));
-  }
-  if (options.coarse_aggregate > 0) impl_->coarse.emplace(impl_->h, options.coarse_aggregate);
+  // 0 is off; CoarseSpace rejects any other size below 2.
+  if (options.coarse_aggregate != 0) impl_->coarse.emplace(impl_->h, options.coarse_aggregate);
 }
 
 ClothSolver::~ClothSolver() = default;

@@ -97,19 +97,12 @@ PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
     const double pq = dot(p, q);
     if (!(pq > 0.0)) break;  // breakdown: PSD matrix and nonzero p make this impossible in theory
     const double alpha = delta / pq;
-    if (coarse != nullptr) {
-      for_each_vertex(n, [&](int i) {
-        dv[i] += alpha * p[i];
-        r[i] -= alpha * q[i];
-      });
-      measure = two_level(r, s);
-    } else {
-      for_each_vertex(n, [&](int i) {
-        dv[i] += alpha * p[i];
-        r[i] -= alpha * q[i];
-        s[i] = filter.apply(i, pinv[i] * r[i]);
-      });
-    }
+    for_each_vertex(n, [&](int i) {
+      dv[i] += alpha * p[i];
+      r[i] -= alpha * q[i];
+      if (coarse == nullptr) s[i] = filter.apply(i, pinv[i] * r[i]);
+    });
+    if (coarse != nullptr) measure = two_level(r, s);
     const double delta_new = dot(r, s);
     result.iterations = it + 1;
     if (!std::isfinite(delta_new)) {

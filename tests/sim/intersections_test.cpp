@@ -4,6 +4,7 @@
 #include "clothcd/sim/intersections.hpp"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <random>
@@ -46,14 +47,15 @@ TEST(IntersectionCounter, BvhEqualsBruteForceSelfAndBody) {
       p = Vec3(p.x(), p.z() - 0.05, 0.05) + test::random_vec(rng, 0.01);
     }
     IntersectionCounter counter(cloth, {}, b.faces, static_cast<int>(b.positions.size()));
-    const auto self = counter.self_pairs(in.positions);
     const auto self_ref = counter.self_pairs_brute_force(in.positions);
-    EXPECT_FALSE(self_ref.empty());
-    EXPECT_EQ(self, self_ref);
-    const auto body = counter.body_pairs(in.positions, b.positions);
     const auto body_ref = counter.body_pairs_brute_force(in.positions, b.positions);
+    EXPECT_FALSE(self_ref.empty());
     EXPECT_FALSE(body_ref.empty());
-    EXPECT_EQ(body, body_ref);
+    for (int threads : {1, 2}) {  // the traversals are parallel; the lists are merged and sorted
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+      EXPECT_EQ(counter.self_pairs(in.positions), self_ref) << threads << " threads";
+      EXPECT_EQ(counter.body_pairs(in.positions, b.positions), body_ref) << threads << " threads";
+    }
   }
 }
 
