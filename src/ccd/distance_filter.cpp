@@ -5,6 +5,7 @@
 #include <initializer_list>
 #include <stdexcept>
 
+#include "ccd/face_bounds.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/ccd/queries.hpp"
 #include "distances.hpp"
@@ -108,6 +109,16 @@ bool distance_filter_culls(const VertexFaceQuery& q, double thickness, int depth
 
 bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness, int depth) {
   return filter_culls(q, thickness, depth);
+}
+
+bool distance_filter_culls(const TriangleTriangleQuery& q, double thickness) {
+  for (const Vec3* x : {&q.a0_t0, &q.a1_t0, &q.a2_t0, &q.b0_t0, &q.b1_t0, &q.b2_t0, &q.a0_t1,
+                        &q.a1_t1, &q.a2_t1, &q.b0_t1, &q.b1_t1, &q.b2_t1}) {
+    if (!x->allFinite()) throw std::invalid_argument("distance_filter_culls: non-finite input");
+  }
+  return detail::triangles_filter_culls(
+      {&q.a0_t0, &q.a1_t0, &q.a2_t0}, {&q.a0_t1, &q.a1_t1, &q.a2_t1},
+      {&q.b0_t0, &q.b1_t0, &q.b2_t0}, {&q.b0_t1, &q.b1_t1, &q.b2_t1}, thickness);
 }
 
 }  // namespace clothcd

@@ -6,6 +6,7 @@
 
 #include "clothcd/ccd/proximity.hpp"
 
+#include "ccd/face_bounds.hpp"
 #include "distances.hpp"
 #include "slack.hpp"
 
@@ -167,6 +168,14 @@ double edge_edge_distance_lower_bound(const Eigen::Vector3d& ea0, const Eigen::V
                                       const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
   require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_distance_lower_bound");
   return detail::edge_edge_bound(ea0, ea1, eb0, eb1);
+}
+
+double triangle_triangle_distance_lower_bound(const Eigen::Vector3d& a0, const Eigen::Vector3d& a1,
+                                              const Eigen::Vector3d& a2, const Eigen::Vector3d& b0,
+                                              const Eigen::Vector3d& b1,
+                                              const Eigen::Vector3d& b2) {
+  require_finite({&a0, &a1, &a2, &b0, &b1, &b2}, "triangle_triangle_distance_lower_bound");
+  return detail::triangle_triangle_bound({&a0, &a1, &a2}, {&b0, &b1, &b2});
 }
 
 double point_triangle_distance_if_within(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,

@@ -156,7 +156,12 @@ struct SelfDetector::Impl {
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         NarrowBuffer& out = locals.local();
                         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          triangle_pair(ctx, pairs[i].first, pairs[i].second, out, kvf, kee);
+                          const auto [f, g] = pairs[i];
+                          if (ctx.faces_apart(f, g)) {
+                            ++out.c.faces_apart;
+                            continue;
+                          }
+                          triangle_pair(ctx, f, g, out, kvf, kee);
                         }
                       });
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.vf.size(), 256),
@@ -188,6 +193,7 @@ struct SelfDetector::Impl {
       st.ee_tests += l.c.ee_tests;
       st.vf_np_culled += l.c.vf_np;
       st.ee_np_culled += l.c.ee_np;
+      st.triangle_pairs_apart += l.c.faces_apart;
       res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
       res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
     }
@@ -309,13 +315,21 @@ struct SelfDetector::Impl {
       const double d = edge_edge_distance_if_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
       if (d <= h) out.ee.push_back({a, b, d});
     };
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        Buffer& out = locals.local();
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          triangle_pair(ctx, pairs[i].first, pairs[i].second, out, kvf, kee);
-                        }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          Buffer& out = locals.local();
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const auto [f, g] = pairs[i];
+            // No feature pair is closer than the whole triangles' bound.
+            const Face &a = topo.faces()[f], &b = topo.faces()[g];
+            if (detail::triangle_triangle_bound({&v0[a[0]], &v0[a[1]], &v0[a[2]]},
+                                                {&v0[b[0]], &v0[b[1]], &v0[b[2]]}) > h) {
+              continue;
+            }
+            triangle_pair(ctx, f, g, out, kvf, kee);
+          }
+        });
     Buffer& out = locals.local();
     for (const auto& [v, f] : orphans.vf) {
       if (vf_in_scope(v, f) && detail::overlap(ctx.vertex_box(v), ctx.face_box(f))) kvf(v, f, out);

@@ -81,7 +81,7 @@ void designated_faces(const Topology& topo, std::vector<int>& vertex_face,
 }
 
 BodyPairs close_feature_pairs(const PairSide& cloth, const PairSide& body, double gap,
-                              std::span<const std::uint8_t> cloth_nodes) {
+                              std::span<const std::uint8_t> cloth_nodes, const FacePairSkip& skip) {
   auto near = [gap](const BoxList& a, int i, const BoxList& b, int j) {
     return (a.lo[i].array() <= b.hi[j].array() + gap).all() &&
            (b.lo[j].array() <= a.hi[i].array() + gap).all();
@@ -91,6 +91,7 @@ BodyPairs close_feature_pairs(const PairSide& cloth, const PairSide& body, doubl
   // A feature's box lies in each incident face's, so whenever a feature pair is close, the leaf
   // pair of the two designated faces overlaps and is visited.
   auto visit = [&](int f, int g, BodyPairs& out) {
+    if (skip && skip(f, g)) return;
     for (int v : cf[f]) {
       if (cloth.vertex_face[v] == f && uses(cloth.vertex_use, v) &&
           near(cloth.boxes->vertex, v, body.boxes->face, g))

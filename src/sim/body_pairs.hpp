@@ -6,6 +6,7 @@
 // of the duplicated lists took 37% of the cloth-body queries on multilayer-rumba frame 61).
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -56,13 +57,19 @@ struct BodyPairs {
 void designated_faces(const Topology& topo, std::vector<int>& vertex_face,
                       std::vector<int>& edge_face);
 
+/// Face pairs (cloth face, body face) whose features a caller's bound leaves out at once (see
+/// close_feature_pairs); empty: none.
+using FacePairSkip = std::function<bool(int cloth_face, int body_face)>;
+
 /// The feature pairs whose boxes are within `gap` on every axis (lo_a <= hi_b + gap and
 /// lo_b <= hi_a + gap), sorted, each once. The BVHs' leaf boxes must contain their faces'
 /// feature boxes grown by gap / 2 (a refit with thickness `gap` of the same positions does).
 /// `cloth_nodes` (one flag per cloth BVH node, empty: all) restricts the cloth side to the
 /// leaves below flagged nodes; they must hold every designated face of a used cloth feature.
-/// The same lists for any thread count.
+/// `skip(f, g)` true leaves out every pair whose features' designated faces are f and g. The
+/// same lists for any thread count.
 [[nodiscard]] BodyPairs close_feature_pairs(const PairSide& cloth, const PairSide& body, double gap,
-                                            std::span<const std::uint8_t> cloth_nodes = {});
+                                            std::span<const std::uint8_t> cloth_nodes = {},
+                                            const FacePairSkip& skip = {});
 
 }  // namespace clothcd::sim::detail

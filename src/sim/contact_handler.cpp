@@ -533,7 +533,13 @@ struct ContactHandler::Impl {
       set_scope(nullptr);
       detail::fill_feature_boxes(model.topology(), x0, x0, vertex_use, edge_use, {}, cloth_boxes);
       detail::fill_feature_boxes(*body_topo, b0, b0, {}, {}, {}, body_boxes);
-      const detail::BodyPairs pairs = detail::close_feature_pairs(cloth_side(), body_side(), dh);
+      // No feature pair of two faces is closer than the faces' bound.
+      const detail::BodyPairs pairs =
+          detail::close_feature_pairs(cloth_side(), body_side(), dh, {}, [&](int f, int g) {
+            const Face &a = cf[f], &b = bf[g];
+            return triangle_triangle_distance_lower_bound(x0[a[0]], x0[a[1]], x0[a[2]], b0[b[0]],
+                                                          b0[b[1]], b0[b[2]]) > dh;
+          });
       const auto& vf_cb = pairs.vf_cb;
       const auto& vf_bc = pairs.vf_bc;
       const auto& ee = pairs.ee;
@@ -758,8 +764,20 @@ struct ContactHandler::Impl {
     detail::fill_feature_boxes(model.topology(), x0, x1, vertex_use, edge_use, face_flag,
                                cloth_boxes);
     if (refit_body) detail::fill_feature_boxes(*body_topo, b0, b1, {}, {}, {}, body_boxes);
+    // Face pairs the distance filter culls whole at the full separation (each pair's own is at
+    // most that); not while some pairs cross, whose features' fate is counted as excluded.
+    detail::FacePairSkip apart;
+    if (crossing_body.empty()) {
+      apart = [&](int f, int g) {
+        const Face &a = cf[f], &b = bf[g];
+        return distance_filter_culls(
+            TriangleTriangleQuery{x0[a[0]], x0[a[1]], x0[a[2]], b0[b[0]], b0[b[1]], b0[b[2]],
+                                  x1[a[0]], x1[a[1]], x1[a[2]], b1[b[0]], b1[b[1]], b1[b[2]]},
+            sep);
+      };
+    }
     const detail::BodyPairs pairs =
-        detail::close_feature_pairs(cloth_side(), body_side(), sep, node_flag);
+        detail::close_feature_pairs(cloth_side(), body_side(), sep, node_flag, apart);
     const auto& vf_cb = pairs.vf_cb;
     const auto& vf_bc = pairs.vf_bc;
     const auto& ee = pairs.ee;

@@ -3,6 +3,8 @@
 // and moving pairs at several scales.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -169,12 +171,80 @@ TEST(DistanceFilter, CrossingPairIsNotCulled) {
   EXPECT_FALSE(distance_filter_culls(ee, 0.0));
 }
 
+// The triangle pair's filter culls only where the distance filter culls each of its 15 feature
+// pairs (checked at depth 0 and 6, and by sampling the pair's distance), on random, layered
+// (two cloth layers resting on each other, moving together or sliding) and crossing pairs.
+TEST(DistanceFilter, TrianglePairCullsOnlyWhereEveryFeaturePairCulls) {
+  int culled = 0, layered_culled = 0, cases = 0;
+  for (double scale : {1e-2, 1.0}) {
+    for (double move_ratio : {0.01, 0.1, 1.0}) {
+      Generator g{std::mt19937_64(29), scale, move_ratio * scale};
+      for (int i = 0; i < kCasesPerSetting / 3; ++i, ++cases) {
+        const double thickness = scale * std::pow(10.0, -2 - (i % 3));
+        std::array<V, 3> a0{g.point(), g.point(), g.point()}, b0{g.point(), g.point(), g.point()};
+        const bool layer = i % 2 == 1;
+        if (layer) {  // b rests on a, 0.5-10% of the scale above it
+          const V n = (a0[1] - a0[0]).cross(a0[2] - a0[0]).normalized();
+          const double gap = scale * (0.005 + 0.095 * 0.5 * (1 + g.u(g.rng)));
+          for (int k = 0; k < 3; ++k)
+            b0[k] = a0[(k + 2) % 3] + gap * n + 0.01 * scale * V(g.u(g.rng), 0, 0);
+        }
+        std::array<V, 3> a1, b1;
+        const V common = g.step(V::Zero());
+        for (int k = 0; k < 3; ++k) {  // a shared motion plus each vertex's own, smaller one
+          a1[k] = a0[k] + common + 0.1 * (g.step(a0[k]) - a0[k]);
+          b1[k] = b0[k] + common + 0.1 * (g.step(b0[k]) - b0[k]);
+        }
+        const TriangleTriangleQuery q{a0[0], a0[1], a0[2], b0[0], b0[1], b0[2],
+                                      a1[0], a1[1], a1[2], b1[0], b1[1], b1[2]};
+        if (!distance_filter_culls(q, thickness)) continue;
+        ++culled;
+        layered_culled += layer;
+        for (int k = 0; k < 3; ++k) {
+          const VertexFaceQuery vf_ab{a0[k], b0[0], b0[1], b0[2], a1[k], b1[0], b1[1], b1[2]};
+          const VertexFaceQuery vf_ba{b0[k], a0[0], a0[1], a0[2], b1[k], a1[0], a1[1], a1[2]};
+          for (const auto* vf : {&vf_ab, &vf_ba}) {
+            ASSERT_TRUE(distance_filter_culls(*vf, thickness)) << scale << " " << i;
+            ASSERT_TRUE(distance_filter_culls(*vf, thickness, 6)) << scale << " " << i;
+            ASSERT_GT(min_distance(*vf), thickness) << scale << " " << i;
+          }
+          for (int j = 0; j < 3; ++j) {
+            const int k2 = (k + 1) % 3, j2 = (j + 1) % 3;
+            const EdgeEdgeQuery ee{a0[k], a0[k2], b0[j], b0[j2], a1[k], a1[k2], b1[j], b1[j2]};
+            ASSERT_TRUE(distance_filter_culls(ee, thickness)) << scale << " " << i;
+            ASSERT_TRUE(distance_filter_culls(ee, thickness, 6)) << scale << " " << i;
+            ASSERT_GT(min_distance(ee), thickness) << scale << " " << i;
+          }
+        }
+      }
+    }
+  }
+  // It does its job on layers (the narrow phase's bulk), and not only there.
+  EXPECT_GT(layered_culled, cases / 4);
+  EXPECT_GT(culled, layered_culled);
+  // A vertex of b passing through a: never culled.
+  const V o(0, 0, 0), x(1, 0, 0), y(0, 1, 0);
+  const V p(0.2, 0.2, 0.1), dp(0, 0, -0.2), s(0.9, 0.9, 0.1), t(0.2, 0.9, 0.1);
+  EXPECT_FALSE(
+      distance_filter_culls(TriangleTriangleQuery{o, x, y, p, s, t, o, x, y, p + dp, s, t}, 0.0));
+  // Resting layers 1 mm apart moving together: culled below the gap, not above it.
+  const V up(0, 0, 0.001), shift(0.05, -0.02, 0.03);
+  const TriangleTriangleQuery rest{
+      o,         x,         y,         o + up,         x + up,         y + up,
+      o + shift, x + shift, y + shift, o + up + shift, x + up + shift, y + up + shift};
+  EXPECT_TRUE(distance_filter_culls(rest, 1e-5));
+  EXPECT_FALSE(distance_filter_culls(rest, 0.0011));
+}
+
 TEST(DistanceFilter, NonFiniteThrowsLikeTheKernels) {
   const V a(0, 0, 0), b(1, 0, 0), c(0, 1, 0), n(NAN, 0, 0);
   EXPECT_THROW((void)distance_filter_culls(VertexFaceQuery{n, a, b, c, n, a, b, c}, 0.0),
                std::invalid_argument);
   EXPECT_THROW((void)distance_filter_culls(EdgeEdgeQuery{n, a, b, c, n, a, b, c}, 0.0),
                std::invalid_argument);
+  EXPECT_THROW(
+      (void)distance_filter_culls(TriangleTriangleQuery{a, b, c, a, b, n, a, b, c, a, b, c}, 0.0),
+      std::invalid_argument);
 }
 
 }  // namespace

@@ -2,7 +2,10 @@
 // named degenerate cases with known answers.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -243,6 +246,78 @@ TEST(CcdProximity, LowerBoundsNeverExceedTheDistance) {
     }
   }
   EXPECT_GT(positive, 30000);  // the bounds cull: most random pairs get a positive one
+}
+
+// Smallest of the 15 feature distances (6 VF, 9 EE) between triangles a and b.
+double feature_distance(const std::array<V, 3>& a, const std::array<V, 3>& b) {
+  double d = INFINITY;
+  for (int i = 0; i < 3; ++i) {
+    d = std::min(d, point_triangle_proximity(a[i], b[0], b[1], b[2]).distance);
+    d = std::min(d, point_triangle_proximity(b[i], a[0], a[1], a[2]).distance);
+    for (int j = 0; j < 3; ++j) {
+      d = std::min(d, edge_edge_proximity(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3]).distance);
+    }
+  }
+  return d;
+}
+
+// The triangles' bound never exceeds any of their feature distances: random triangles, layers
+// (b a jittered copy of a, offset along its normal, as two cloth layers resting on each other),
+// slivers and crossing pairs, at the unit scale and at a cloth's.
+TEST(CcdProximity, TriangleBoundNeverExceedsAnyFeatureDistance) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<> u(-1, 1);
+  int positive = 0, layered = 0;
+  for (const double size : {1.0, 1e-2}) {
+    auto vec = [&](const V& at) { return V(at + size * V(u(rng), u(rng), u(rng))); };
+    for (int i = 0; i < 8000; ++i) {
+      const V at = i % 2 == 0 ? V::Zero() : V(0.7, 1.1, -0.4);
+      std::array<V, 3> a{vec(at), vec(at), vec(at)}, b{vec(at), vec(at), vec(at)};
+      switch (i % 4) {
+        case 1: {  // a layer: b above a by up to 10% of the size, tilted a little
+          const V n = (a[1] - a[0]).cross(a[2] - a[0]).normalized();
+          const double gap = 0.1 * size * (0.5 + 0.5 * u(rng));
+          for (int k = 0; k < 3; ++k)
+            b[k] = a[(k + 1) % 3] + gap * n + 0.02 * size * V(u(rng), u(rng), u(rng));
+          break;
+        }
+        case 2:  // a sliver
+          a[2] = a[0] + 0.4 * (a[1] - a[0]) + 1e-9 * size * V(u(rng), u(rng), u(rng));
+          break;
+        case 3:  // b's vertex on a's plane, inside a
+          b[0] = a[0] + 0.3 * (a[1] - a[0]) + 0.3 * (a[2] - a[0]);
+          break;
+        default:
+          break;
+      }
+      const double bound =
+          triangle_triangle_distance_lower_bound(a[0], a[1], a[2], b[0], b[1], b[2]);
+      const double d = feature_distance(a, b);
+      EXPECT_GE(bound, 0.0);
+      EXPECT_LE(bound, d) << size << " " << i;
+      positive += bound > 0;
+      if (i % 4 == 1) layered += bound > 0.5 * d;
+      if (i % 4 == 3) {
+        EXPECT_EQ(bound, 0.0) << size << " " << i;
+      }
+    }
+  }
+  EXPECT_GT(positive, 4000);  // not vacuous
+  EXPECT_GT(layered, 3000);   // and tight on layers, where the narrow phase needs it
+}
+
+TEST(CcdProximity, TriangleBoundIsThePlaneGapOfTwoLayers) {
+  const V o(0, 0, 0), x(1, 0, 0), y(0, 1, 0), up(0, 0, 0.001);
+  // Parallel layers 1 mm apart, b shifted sideways: the gap of the planes.
+  EXPECT_NEAR(triangle_triangle_distance_lower_bound(o, x, y, o + up + V(0.3, 0.2, 0),
+                                                     x + up + V(0.3, 0.2, 0), y + up),
+              0.001, 1e-11);
+  // b straddles a's plane and a straddles b's: nothing proved.
+  EXPECT_EQ(triangle_triangle_distance_lower_bound(o, x, y, V(0.2, 0.2, -1), V(0.2, 0.2, 1),
+                                                   V(0.3, 5, 0)),
+            0.0);
+  EXPECT_THROW((void)triangle_triangle_distance_lower_bound(o, x, y, V(NAN, 0, 0), x, y),
+               std::invalid_argument);
 }
 
 TEST(CcdProximity, LowerBoundsAreTightWhereTheyShouldBe) {

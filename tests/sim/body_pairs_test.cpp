@@ -118,6 +118,27 @@ TEST(BodyPairs, StaticAndSweptBoxesMatchBruteForce) {
   }
 }
 
+TEST(BodyPairs, SkippedFacePairsLeaveOutExactlyTheirFeaturePairs) {
+  // Every third (cloth face, body face) pair skipped: the pairs whose designated faces are a
+  // skipped pair go, and only those.
+  Scene s;
+  const double gap = 1e-3;
+  s.cloth.prepare(gap, false);
+  s.body.prepare(gap, false);
+  auto skip = [](int f, int g) { return (f + 2 * g) % 3 == 0; };
+  const BodyPairs got = detail::close_feature_pairs(s.cloth.side(), s.body.side(), gap, {}, skip);
+  BodyPairs want = brute_force(s.cloth, s.body, gap, {}, {}, {});
+  const std::size_t all = want.vf_cb.size() + want.vf_bc.size() + want.ee.size();
+  std::erase_if(want.vf_cb, [&](auto p) { return skip(s.cloth.vface[p.first], p.second); });
+  std::erase_if(want.vf_bc, [&](auto p) { return skip(p.second, s.body.vface[p.first]); });
+  std::erase_if(want.ee,
+                [&](auto p) { return skip(s.cloth.eface[p.first], s.body.eface[p.second]); });
+  expect_same(got, want);
+  const std::size_t kept = want.vf_cb.size() + want.vf_bc.size() + want.ee.size();
+  EXPECT_GT(kept, 0u);
+  EXPECT_LT(kept, all);
+}
+
 TEST(BodyPairs, UseFlagsAndNodeRestrictionMatchBruteForce) {
   Scene s;
   const double gap = 1e-3;

@@ -49,6 +49,15 @@ struct EdgeEdgeProximity {
                                                     const Eigen::Vector3d& eb0,
                                                     const Eigen::Vector3d& eb1);
 
+/// Lower bound on the distance between two whole triangles a and b, so on every VF and EE
+/// distance between them: the larger of their boxes' gap and how far either triangle's plane
+/// keeps the other wholly on one side (skipped for slivers), less the same rounding allowance.
+/// 0 where it proves nothing (the triangles straddle each other's planes). Finite input is
+/// required (std::invalid_argument otherwise).
+[[nodiscard]] double triangle_triangle_distance_lower_bound(
+    const Eigen::Vector3d& a0, const Eigen::Vector3d& a1, const Eigen::Vector3d& a2,
+    const Eigen::Vector3d& b0, const Eigen::Vector3d& b1, const Eigen::Vector3d& b2);
+
 /// The exact distance where it is at most `limit`; elsewhere some value above `limit` (the lower
 /// bound, when that already exceeds `limit`: the exact query is then skipped). For callers that
 /// only compare the distance with a limit. Finite input is required (std::invalid_argument

@@ -24,6 +24,12 @@ struct EdgeEdgeQuery {
   Eigen::Vector3d ea0_t1, ea1_t1, eb0_t1, eb1_t1;
 };
 
+/// Two triangles a and b moving linearly (for the whole-triangle distance filter).
+struct TriangleTriangleQuery {
+  Eigen::Vector3d a0_t0, a1_t0, a2_t0, b0_t0, b1_t0, b2_t0;
+  Eigen::Vector3d a0_t1, a1_t1, a2_t1, b0_t1, b1_t1, b2_t1;
+};
+
 struct CcdOptions {
   /// Contact when the distance drops to this (>= 0). 0 is exact contact.
   double thickness = 0.0;
@@ -88,5 +94,12 @@ struct CcdResult {
 /// std::invalid_argument.
 [[nodiscard]] bool distance_filter_culls(const VertexFaceQuery& q, double thickness, int depth = 0);
 [[nodiscard]] bool distance_filter_culls(const EdgeEdgeQuery& q, double thickness, int depth = 0);
+/// The distance filter for all 15 feature pairs (6 VF, 9 EE) of two triangles at once: the
+/// whole-step bound with the triangles' distance lower bound
+/// (triangle_triangle_distance_lower_bound) at both ends and D over all their vertices. Where
+/// it culls, distance_filter_culls culls each feature pair (at any depth), so a narrow phase may
+/// skip them all; it proves nothing where the triangles straddle each other's planes. NaN or
+/// infinite coordinates throw std::invalid_argument.
+[[nodiscard]] bool distance_filter_culls(const TriangleTriangleQuery& q, double thickness);
 
 }  // namespace clothcd

@@ -75,7 +75,9 @@ struct DetectStats {
   int disk_internal_nodes = 0;
   std::uint64_t adjacent_pairs = 0;  ///< overlapping vertex-sharing leaf pairs (left to orphans)
   std::uint64_t triangle_pairs = 0;  ///< non-adjacent triangle pairs reaching the narrow phase
-  std::uint64_t vf_tests = 0;        ///< VF feature pairs past the feature box test (incl. orphans)
+  /// ... of which culled whole by the distance filter (thickness > 0), their features untested
+  std::uint64_t triangle_pairs_apart = 0;
+  std::uint64_t vf_tests = 0;  ///< VF feature pairs past the feature box test (incl. orphans)
   std::uint64_t ee_tests = 0;
   std::uint64_t vf_np_culled = 0;  ///< ... of which the NP filter culled
   std::uint64_t ee_np_culled = 0;
