@@ -232,11 +232,14 @@ class FeatureBoxes {
     for_each(nv, [&](int i) {
       if (redo(std::array<int, 1>{i})) vboxes_[i] = ctx.compute_vertex_box(i);
     });
+    // An edge's or face's box is the union of its vertices' boxes bit for bit: swept_box's
+    // rounding (minus the margin, next_down, to float downwards) is monotone, so the rounded
+    // minimum of the points is the minimum of their rounded values (likewise upwards).
     for_each(topo.num_edges(), [&](int e) {
-      if (redo(topo.edges()[e])) eboxes_[e] = ctx.compute_edge_box(e);
+      if (redo(topo.edges()[e])) eboxes_[e] = merged(topo.edges()[e]);
     });
     for_each(topo.num_faces(), [&](int f) {
-      if (redo(topo.faces()[f])) fboxes_[f] = ctx.compute_face_box(f);
+      if (redo(topo.faces()[f])) fboxes_[f] = merged(topo.faces()[f]);
     });
     ctx.vboxes = vboxes_;
     ctx.eboxes = eboxes_;
@@ -244,6 +247,19 @@ class FeatureBoxes {
   }
 
  private:
+  template <class Ids>
+  [[nodiscard]] Box merged(const Ids& ids) const {
+    Box b = vboxes_[ids[0]];
+    for (std::size_t k = 1; k < ids.size(); ++k) {
+      const Box& o = vboxes_[ids[k]];
+      for (int a = 0; a < 3; ++a) {
+        b.lo[a] = std::min(b.lo[a], o.lo[a]);
+        b.hi[a] = std::max(b.hi[a], o.hi[a]);
+      }
+    }
+    return b;
+  }
+
   template <class F>
   static void for_each(int n, F&& f) {
     tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
