@@ -28,44 +28,19 @@ double dot(const Vecs& a, const Vecs& b) {
   });
 }
 
-// Row i of apply_system: the operations of multiply, the mass term, the couplings' scatter and
-// the filter in that order, so the bits are those of four separate passes. `couplings` must have
-// gathered x (null: none).
-Vec3 system_row(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x,
-                const CouplingTerms* couplings, const VertexFilter* filter, int i) {
-  Vec3 yi = mass[i] * x[i] + c * row_product(h, x, i);
-  if (couplings != nullptr) couplings->add_gathered(i, yi);
-  return filter != nullptr ? filter->apply(i, yi) : yi;
-}
-
-const CouplingTerms* gathered(const CouplingTerms* couplings, const Vecs& x) {
-  if (couplings == nullptr || couplings->empty()) return nullptr;
-  couplings->gather(x);
-  return couplings;
-}
-
-// apply_system and then dot(x, y) in one pass: the dot's ranges are deterministic_sum's, each
-// summed in row order right after its rows are computed, so the result is dot's bit for bit.
-double apply_system_dot(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x,
-                        Vecs& y, const CouplingTerms* couplings, const VertexFilter* filter) {
-  couplings = gathered(couplings, x);
-  return deterministic_sum(static_cast<int>(x.size()), [&](int lo, int hi) {
-    double s = 0.0;
-    for (int i = lo; i < hi; ++i) {
-      y[i] = system_row(h, c, mass, x, couplings, filter, i);
-      s += x[i].dot(y[i]);
-    }
-    return s;
-  });
-}
-
 }  // namespace
 
 void apply_system(const BlockCsr& h, double c, std::span<const double> mass, const Vecs& x, Vecs& y,
                   const CouplingTerms* couplings, const VertexFilter* filter) {
-  couplings = gathered(couplings, x);
-  for_each_vertex(static_cast<int>(x.size()),
-                  [&](int i) { y[i] = system_row(h, c, mass, x, couplings, filter, i); });
+  // One pass over the rows; per row the operations of multiply, the mass term, the couplings'
+  // scatter and the filter in that order, so the bits are those of four separate passes.
+  if (couplings != nullptr && couplings->empty()) couplings = nullptr;
+  if (couplings != nullptr) couplings->gather(x);
+  for_each_vertex(static_cast<int>(x.size()), [&](int i) {
+    Vec3 yi = mass[i] * x[i] + c * row_product(h, x, i);
+    if (couplings != nullptr) couplings->add_gathered(i, yi);
+    y[i] = filter != nullptr ? filter->apply(i, yi) : yi;
+  });
 }
 
 PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
@@ -118,31 +93,17 @@ PcgResult solve_pcg(const BlockCsr& h, double c, std::span<const double> mass,
     return result;
   }
   for (int it = 0; it < options.max_iterations; ++it) {
-    const double pq = apply_system_dot(h, c, mass, p, q, couplings, &filter);
+    apply_system(h, c, mass, p, q, couplings, &filter);
+    const double pq = dot(p, q);
     if (!(pq > 0.0)) break;  // breakdown: PSD matrix and nonzero p make this impossible in theory
     const double alpha = delta / pq;
-    // The update and, for block Jacobi, the preconditioner and dot(r, s) in one pass (the dot
-    // fused as in apply_system_dot).
-    double delta_new = 0.0;
-    if (coarse == nullptr) {
-      delta_new = deterministic_sum(n, [&](int lo, int hi) {
-        double sum = 0.0;
-        for (int i = lo; i < hi; ++i) {
-          dv[i] += alpha * p[i];
-          r[i] -= alpha * q[i];
-          s[i] = filter.apply(i, pinv[i] * r[i]);
-          sum += r[i].dot(s[i]);
-        }
-        return sum;
-      });
-    } else {
-      for_each_vertex(n, [&](int i) {
-        dv[i] += alpha * p[i];
-        r[i] -= alpha * q[i];
-      });
-      measure = two_level(r, s);
-      delta_new = dot(r, s);
-    }
+    for_each_vertex(n, [&](int i) {
+      dv[i] += alpha * p[i];
+      r[i] -= alpha * q[i];
+      if (coarse == nullptr) s[i] = filter.apply(i, pinv[i] * r[i]);
+    });
+    if (coarse != nullptr) measure = two_level(r, s);
+    const double delta_new = dot(r, s);
     result.iterations = it + 1;
     if (!std::isfinite(delta_new)) {
       delta = measure = delta_new;
