@@ -15,10 +15,10 @@ double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return (b - a).cross(c - a).dot(d - a);
 }
 
-// Segment pq passes strictly through the plane of abc at a point inside (or on the border of) abc.
-bool segment_crosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const double dp = orient(a, b, c, p);
-  const double dq = orient(a, b, c, q);
+// Segment pq passes strictly through the plane of abc (dp, dq: orient(a, b, c, p), (.., q)) at a
+// point inside (or on the border of) abc.
+bool segment_crosses(const Vec3& p, const Vec3& q, double dp, double dq, const Vec3& a,
+                     const Vec3& b, const Vec3& c) {
   if (!((dp > 0 && dq < 0) || (dp < 0 && dq > 0))) return false;
   const double s0 = orient(p, q, a, b);
   const double s1 = orient(p, q, b, c);
@@ -41,10 +41,17 @@ std::vector<std::pair<int, int>> merged(
 bool triangles_intersect(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0,
                          const Vec3& b1, const Vec3& b2) {
   // Two triangles that cross meet in a segment whose ends lie on edges; so some edge of one
-  // pierces the other.
-  return segment_crosses(a0, a1, b0, b1, b2) || segment_crosses(a1, a2, b0, b1, b2) ||
-         segment_crosses(a2, a0, b0, b1, b2) || segment_crosses(b0, b1, a0, a1, a2) ||
-         segment_crosses(b1, b2, a0, a1, a2) || segment_crosses(b2, b0, a0, a1, a2);
+  // pierces the other. Each vertex's side of the other plane is computed once for its two edges.
+  const double da0 = orient(b0, b1, b2, a0), da1 = orient(b0, b1, b2, a1),
+               da2 = orient(b0, b1, b2, a2);
+  const double db0 = orient(a0, a1, a2, b0), db1 = orient(a0, a1, a2, b1),
+               db2 = orient(a0, a1, a2, b2);
+  return segment_crosses(a0, a1, da0, da1, b0, b1, b2) ||
+         segment_crosses(a1, a2, da1, da2, b0, b1, b2) ||
+         segment_crosses(a2, a0, da2, da0, b0, b1, b2) ||
+         segment_crosses(b0, b1, db0, db1, a0, a1, a2) ||
+         segment_crosses(b1, b2, db1, db2, a0, a1, a2) ||
+         segment_crosses(b2, b0, db2, db0, a0, a1, a2);
 }
 
 struct IntersectionCounter::Impl {
