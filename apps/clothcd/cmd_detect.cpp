@@ -50,6 +50,7 @@ nlohmann::json stats_json(const DetectStats& s) {
           {"disk_internal_nodes", s.disk_internal_nodes},
           {"adjacent_pairs", s.adjacent_pairs},
           {"triangle_pairs", s.triangle_pairs},
+          {"triangle_pairs_apart", s.triangle_pairs_apart},
           {"vf_tests", s.vf_tests},
           {"ee_tests", s.ee_tests},
           {"vf_np_culled", s.vf_np_culled},
@@ -224,13 +225,14 @@ int run(const Args& a) {
   const DetectStats& s = r.stats;
   fmt::print(
       "{} triangles, bvh {} ({:.1f}% edge-connected, {:.1f}% disk internal nodes), policy {}, "
-      "culling {}\ntriangle pairs {}, nodes culled {}, VF tests {} (NP culled {}), EE tests {} "
-      "(NP culled {})\ncollisions: {} VF, {} EE\ntime: refit {:.4f} s, traversal {:.4f} s, "
-      "narrow phase {:.4f} s\n",
+      "culling {}\ntriangle pairs {} ({} culled whole by the distance filter), nodes culled {}, VF "
+      "tests {} (NP culled {}), EE tests {} (NP culled {})\ncollisions: {} VF, {} EE\ntime: refit "
+      "{:.4f} s, traversal {:.4f} s, narrow phase {:.4f} s\n",
       w0.num_faces(), a.bvh, 100 * s.connected_share(),
       100.0 * s.disk_internal_nodes / std::max(1, s.internal_nodes), a.policy, a.culling,
-      s.triangle_pairs, s.nodes_culled, s.vf_tests, s.vf_np_culled, s.ee_tests, s.ee_np_culled,
-      r.vf.size(), r.ee.size(), s.time_refit, s.time_traverse, s.time_narrow);
+      s.triangle_pairs, s.triangle_pairs_apart, s.nodes_culled, s.vf_tests, s.vf_np_culled,
+      s.ee_tests, s.ee_np_culled, r.vf.size(), r.ee.size(), s.time_refit, s.time_traverse,
+      s.time_narrow);
   if (r.verified) {
     fmt::print(
         "verify: {} VF and {} EE collisions missed against culling none ({} triangle "

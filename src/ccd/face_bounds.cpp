@@ -1,3 +1,4 @@
+// Distance bounds of whole triangles (face_bounds.hpp).
 #include "ccd/face_bounds.hpp"
 
 #include <Eigen/Geometry>
@@ -13,8 +14,7 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 
 // How far b lies wholly on one side of a's plane (0 where it straddles it). The normal is trusted
-// as in the feature bounds (proximity.cpp): only where the sine of a's smallest angle at a[0]
-// exceeds 1e-3.
+// as in the feature bounds (proximity.cpp): only where the sine of a's angle at a[0] exceeds 1e-3.
 double plane_separation(const Triangle& a, const Triangle& b) {
   const Vec3 u = *a[1] - *a[0], v = *a[2] - *a[0];
   const Vec3 w = u.cross(v);
