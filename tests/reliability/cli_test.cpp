@@ -162,6 +162,28 @@ TEST(CliDeterminism, DetectSameForOneTwoAndFourThreads) {
   EXPECT_EQ(results[0]["ee"], results[1]["ee"]);
 }
 
+TEST(CliDetect, ThicknessReportsTrianglePairsCulledWhole) {
+  // With a thickness the distance filter culls whole triangle pairs first: the count is in the
+  // JSON and the summary, and is 0 without a thickness (the cubic filter then works alone).
+  CliScratch dir;
+  write_step(dir);
+  for (const char* thickness : {"0", "0.001"}) {
+    const auto r = dir.run(std::string("detect --t0 t0.obj --t1 t1.obj --thickness ") + thickness +
+                           " --json out.json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(CliScratch::slurp(dir / "out.json"));
+    const auto apart = j["stats"]["triangle_pairs_apart"].get<std::uint64_t>();
+    const auto pairs = j["stats"]["triangle_pairs"].get<std::uint64_t>();
+    EXPECT_NE(r.out.find("culled whole by the distance filter"), std::string::npos) << r.out;
+    if (std::string(thickness) == "0") {
+      EXPECT_EQ(apart, 0u);
+    } else {
+      EXPECT_GT(apart, 0u);
+      EXPECT_LT(apart, pairs);
+    }
+  }
+}
+
 TEST(CliCcdQueries, MalformedCsvWithJson) {
   CliScratch dir;
   // One query is 8 rows (4 points at t0 and t1) of "x_num,x_den,y_num,y_den,z_num,z_den,truth".
