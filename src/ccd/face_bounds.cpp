@@ -45,11 +45,16 @@ double slack(const Triangle& a, const Triangle& b) {
   return coordinate_slack({a[0], a[1], a[2], b[0], b[1], b[2]});
 }
 
+// triangle_triangle_bound given the two triangles' slack.
+double bound_less(const Triangle& a, const Triangle& b, double slack) {
+  const double bound = std::max({box_gap(a, b), plane_separation(a, b), plane_separation(b, a)});
+  return std::max(0.0, bound - slack);
+}
+
 }  // namespace
 
 double triangle_triangle_bound(const Triangle& a, const Triangle& b) {
-  const double bound = std::max({box_gap(a, b), plane_separation(a, b), plane_separation(b, a)});
-  return std::max(0.0, bound - slack(a, b));
+  return bound_less(a, b, slack(a, b));
 }
 
 bool triangles_filter_culls(const Triangle& a_t0, const Triangle& a_t1, const Triangle& b_t0,
@@ -62,9 +67,10 @@ bool triangles_filter_culls(const Triangle& a_t0, const Triangle& a_t1, const Tr
   }
   // The same test as the distance filter's whole-step bound, with the largest slack of any of
   // the feature pairs (theirs are taken over fewer points).
-  const double eps = std::max(slack(a_t0, b_t0), slack(a_t1, b_t1));
-  const double bound = 0.5 * (triangle_triangle_bound(a_t0, b_t0) +
-                              triangle_triangle_bound(a_t1, b_t1) - std::sqrt(move2));
+  const double s0 = slack(a_t0, b_t0), s1 = slack(a_t1, b_t1);
+  const double eps = std::max(s0, s1);
+  const double bound =
+      0.5 * (bound_less(a_t0, b_t0, s0) + bound_less(a_t1, b_t1, s1) - std::sqrt(move2));
   return std::isfinite(bound) && bound > thickness + eps;
 }
 

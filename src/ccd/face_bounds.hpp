@@ -6,10 +6,16 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <span>
 
 namespace clothcd::detail {
 
 using Triangle = std::array<const Eigen::Vector3d*, 3>;
+
+/// The corners of face f (vertex ids) in positions x.
+inline Triangle corners(std::span<const Eigen::Vector3d> x, const std::array<int, 3>& f) {
+  return {&x[f[0]], &x[f[1]], &x[f[2]]};
+}
 
 /// Lower bound on the distance between triangles a and b, less the rounding allowance of
 /// slack.hpp: the larger of their boxes' gap and the separation by either triangle's plane (how

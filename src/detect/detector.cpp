@@ -315,21 +315,20 @@ struct SelfDetector::Impl {
       const double d = edge_edge_distance_if_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
       if (d <= h) out.ee.push_back({a, b, d});
     };
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          Buffer& out = locals.local();
-          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const auto [f, g] = pairs[i];
-            // No feature pair is closer than the whole triangles' bound.
-            const Face &a = topo.faces()[f], &b = topo.faces()[g];
-            if (detail::triangle_triangle_bound({&v0[a[0]], &v0[a[1]], &v0[a[2]]},
-                                                {&v0[b[0]], &v0[b[1]], &v0[b[2]]}) > h) {
-              continue;
-            }
-            triangle_pair(ctx, f, g, out, kvf, kee);
-          }
-        });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        Buffer& out = locals.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const auto [f, g] = pairs[i];
+                          // No feature pair is closer than the whole triangles' bound.
+                          const Face &a = topo.faces()[f], &b = topo.faces()[g];
+                          if (detail::triangle_triangle_bound(detail::corners(v0, a),
+                                                              detail::corners(v0, b)) > h) {
+                            continue;
+                          }
+                          triangle_pair(ctx, f, g, out, kvf, kee);
+                        }
+                      });
     Buffer& out = locals.local();
     for (const auto& [v, f] : orphans.vf) {
       if (vf_in_scope(v, f) && detail::overlap(ctx.vertex_box(v), ctx.face_box(f))) kvf(v, f, out);

@@ -126,9 +126,8 @@ struct FeatureContext {
     if (!distance_filter()) return false;
     const Face& a = topo->faces()[f];
     const Face& b = topo->faces()[g];
-    return triangles_filter_culls(
-        {&v0[a[0]], &v0[a[1]], &v0[a[2]]}, {&v1[a[0]], &v1[a[1]], &v1[a[2]]},
-        {&v0[b[0]], &v0[b[1]], &v0[b[2]]}, {&v1[b[0]], &v1[b[1]], &v1[b[2]]}, ccd.thickness);
+    return triangles_filter_culls(corners(v0, a), corners(v1, a), corners(v0, b), corners(v1, b),
+                                  ccd.thickness);
   }
 
   /// Vertex v against face f (their boxes already overlap): NP filter, then the kernel.
