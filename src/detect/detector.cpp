@@ -34,6 +34,14 @@ struct PairBuffer {
   std::uint64_t adjacent = 0;
 };
 
+// Options the detector cannot honour are refused before any work.
+void check_options(const DetectOptions& o) {
+  if (!(o.reuse_distance >= 0) || !std::isfinite(o.reuse_distance)) {
+    throw InputError(
+        fmt::format("reuse distance must be finite and >= 0, got {}", o.reuse_distance));
+  }
+}
+
 struct NarrowBuffer {
   detail::FeatureCounters c;
   std::vector<VertexFaceCollision> vf;
@@ -49,7 +57,9 @@ struct SelfDetector::Impl {
   detail::Orphans orphans;
   std::vector<Eigen::Vector3d> v0, v1;
   // Active restriction: features on active faces, and the nodes holding a face that touches one.
+  // `outside` turns it into its complement (the pairs the restriction leaves out).
   bool restricted = false;
+  bool outside = false;
   std::vector<std::uint8_t> face_active, vertex_active, edge_active, node_active;
   // Swept boxes of the features, updated where vertices moved (see FeatureBoxes).
   detail::FeatureBoxes boxes;
@@ -58,9 +68,18 @@ struct SelfDetector::Impl {
   std::vector<std::pair<int, int>> links;
   bool links_current = false;
   detail::Ownership owner;
+  // The triangle pairs of the last unrestricted detect() with boxes widened to
+  // opt.reuse_distance, and its positions at t1: a proximity query at most that far needs no
+  // traversal for the vertices still there (see DetectOptions::reuse_distance).
+  struct Reuse {
+    bool valid = false;
+    std::vector<Eigen::Vector3d> x1;
+    std::vector<std::pair<int, int>> pairs;
+  } reuse;
 
   Impl(std::vector<Face> faces, int nv, const Positions& ref, const DetectOptions& o)
       : topo(std::move(faces), nv), opt(o) {
+    check_options(o);
     detail::to_points(ref, nv, "reference shape", v0);
     bvh = Bvh(topo, v0, o.build);
     orphans = detail::find_orphans(topo);
@@ -71,11 +90,17 @@ struct SelfDetector::Impl {
     return mode != Culling::None && !(mode == Culling::Sound && opt.thickness > 0);
   }
 
+  // Boxes widened for reuse: only when no cone culls, so the traversal lists every overlapping
+  // leaf pair.
+  [[nodiscard]] bool widened() const {
+    return opt.reuse_distance > opt.thickness && !cones_used(opt.culling);
+  }
+
   [[nodiscard]] bool vf_in_scope(int v, int f) const {
-    return !restricted || vertex_active[v] != 0 || face_active[f] != 0;
+    return !restricted || ((vertex_active[v] != 0 || face_active[f] != 0) != outside);
   }
   [[nodiscard]] bool ee_in_scope(int ea, int eb) const {
-    return !restricted || edge_active[ea] != 0 || edge_active[eb] != 0;
+    return !restricted || ((edge_active[ea] != 0 || edge_active[eb] != 0) != outside);
   }
 
   // Overlapping non-adjacent leaf pairs of the culled self traversal.
@@ -150,6 +175,7 @@ struct SelfDetector::Impl {
   void narrow(const detail::FeatureContext& ctx, const std::vector<std::pair<int, int>>& pairs,
               DetectResult& res) {
     tbb::enumerable_thread_specific<NarrowBuffer> locals;
+    const bool wide = widened();
     auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
     auto kee = [&](int a, int b, NarrowBuffer& out) { ctx.kernel_ee(a, b, out.c, out.ee); };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
@@ -157,6 +183,9 @@ struct SelfDetector::Impl {
                         NarrowBuffer& out = locals.local();
                         for (std::size_t i = r.begin(); i != r.end(); ++i) {
                           const auto [f, g] = pairs[i];
+                          // Widened leaf boxes: no feature pair of faces whose own boxes miss.
+                          if (wide && !detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) continue;
+                          ++out.c.triangle_pairs;
                           if (ctx.faces_apart(f, g)) {
                             ++out.c.faces_apart;
                             continue;
@@ -185,7 +214,7 @@ struct SelfDetector::Impl {
                         }
                       });
     DetectStats& st = res.stats;
-    st.triangle_pairs = pairs.size();
+    st.triangle_pairs = 0;
     st.vf_orphans = orphans.vf.size();
     st.ee_orphans = orphans.ee.size();
     for (auto& l : locals) {
@@ -194,6 +223,7 @@ struct SelfDetector::Impl {
       st.vf_np_culled += l.c.vf_np;
       st.ee_np_culled += l.c.ee_np;
       st.triangle_pairs_apart += l.c.faces_apart;
+      st.triangle_pairs += l.c.triangle_pairs;
       res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
       res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
     }
@@ -250,7 +280,7 @@ struct SelfDetector::Impl {
     DetectStats& st = res.stats;
     auto t = Clock::now();
     RefitOptions ro;
-    ro.thickness = opt.thickness;
+    ro.thickness = widened() ? opt.reuse_distance : opt.thickness;
     ro.cones = cones_used(opt.culling);
     ro.policy = opt.policy;
     bvh.refit_changed(v0, v1, ro);
@@ -260,13 +290,18 @@ struct SelfDetector::Impl {
     st.disk_internal_nodes = bvh.num_disk_internal();
 
     t = Clock::now();
-    const auto pairs = traverse(opt.culling, st);
+    auto pairs = traverse(opt.culling, st);
     st.time_traverse = seconds_since(t);
     t = Clock::now();
     detail::FeatureContext ctx = ccd_context();
     boxes.update(ctx);
     narrow(ctx, pairs, res);
     st.time_narrow = seconds_since(t);
+    if (widened() && !restricted) {
+      reuse.x1 = v1;
+      reuse.pairs = std::move(pairs);
+      reuse.valid = true;
+    }
 
     if (opt.verify && opt.culling != Culling::None) {
       DetectResult ref;
@@ -292,8 +327,6 @@ struct SelfDetector::Impl {
     ro.thickness = h;
     ro.cones = false;  // cones carry no distance information (algorithms.md 1.1)
     bvh.refit(v0, ro);
-    DetectStats st;
-    const auto pairs = traverse(Culling::None, st);
     detail::FeatureContext ctx;
     ctx.topo = &topo;
     ctx.v0 = v0;
@@ -315,20 +348,41 @@ struct SelfDetector::Impl {
       const double d = edge_edge_distance_if_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
       if (d <= h) out.ee.push_back({a, b, d});
     };
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        Buffer& out = locals.local();
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          const auto [f, g] = pairs[i];
-                          // No feature pair is closer than the whole triangles' bound.
-                          const Face &a = topo.faces()[f], &b = topo.faces()[g];
-                          if (detail::triangle_triangle_bound(detail::corners(v0, a),
-                                                              detail::corners(v0, b)) > h) {
-                            continue;
+    auto test_pairs = [&](const std::vector<std::pair<int, int>>& pairs) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          Buffer& out = locals.local();
+                          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                            const auto [f, g] = pairs[i];
+                            if (!detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) continue;
+                            // No feature pair is closer than the whole triangles' bound.
+                            const Face &a = topo.faces()[f], &b = topo.faces()[g];
+                            if (detail::triangle_triangle_bound(detail::corners(v0, a),
+                                                                detail::corners(v0, b)) > h) {
+                              continue;
+                            }
+                            triangle_pair(ctx, f, g, out, kvf, kee);
                           }
-                          triangle_pair(ctx, f, g, out, kvf, kee);
-                        }
-                      });
+                        });
+    };
+    DetectStats st;
+    std::size_t reused = 0;
+    if (reusable(h)) {
+      // The kept pairs hold every pair of features on vertices still at their t1 positions (the
+      // widened boxes held these positions and more); a traversal restricted to the moved
+      // vertices finds the rest. The two scopes split the feature pairs exactly.
+      struct Unrestrict {
+        Impl& im;
+        ~Unrestrict() { im.restricted = im.outside = false; }
+      } unrestrict{*this};
+      outside = true;
+      test_pairs(reuse.pairs);
+      reused = reuse.pairs.size();
+      outside = false;
+      test_pairs(traverse(Culling::None, st));
+    } else {
+      test_pairs(traverse(Culling::None, st));
+    }
     Buffer& out = locals.local();
     for (const auto& [v, f] : orphans.vf) {
       if (vf_in_scope(v, f) && detail::overlap(ctx.vertex_box(v), ctx.face_box(f))) kvf(v, f, out);
@@ -337,6 +391,7 @@ struct SelfDetector::Impl {
       if (ee_in_scope(a, b) && detail::overlap(ctx.edge_box(a), ctx.edge_box(b))) kee(a, b, out);
     }
     ProximityResult res;
+    res.reused_pairs = reused;
     for (const auto& l : locals) {
       res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
       res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
@@ -348,6 +403,20 @@ struct SelfDetector::Impl {
       return std::pair(a.edge_a, a.edge_b) < std::pair(b.edge_a, b.edge_b);
     });
     return res;
+  }
+
+  // Whether proximity(v0, h) can use the kept pairs: then the active restriction is set to the
+  // vertices that moved since (few, or the traversal is cheaper).
+  bool reusable(double h) {
+    if (!reuse.valid || restricted || h > opt.reuse_distance || !widened()) return false;
+    const int nv = topo.num_vertices();
+    std::vector<int> moved;
+    for (int i = 0; i < nv; ++i) {
+      if (v0[i] != reuse.x1[i]) moved.push_back(i);
+    }
+    if (4 * moved.size() > static_cast<std::size_t>(nv)) return false;
+    set_active_vertices(moved);
+    return true;
   }
 
   void set_active(std::span<const int> active_faces) {
@@ -424,10 +493,12 @@ const DetectOptions& SelfDetector::options() const {
   return impl_->opt;
 }
 void SelfDetector::set_options(const DetectOptions& options) {
+  check_options(options);
   const BvhBuild build = impl_->opt.build;
   impl_->opt = options;
   impl_->opt.build = build;
   impl_->links_current = false;
+  impl_->reuse.valid = false;
 }
 const Topology& SelfDetector::topology() const {
   return impl_->topo;

@@ -76,7 +76,8 @@ inline bool share_vertex(const Face& a, const Face& b) {
 /// Per-thread counters of the feature tests.
 struct FeatureCounters {
   std::uint64_t vf_tests = 0, ee_tests = 0, vf_np = 0, ee_np = 0;
-  std::uint64_t faces_apart = 0;  // triangle pairs culled whole (FeatureContext::faces_apart)
+  std::uint64_t triangle_pairs = 0;  // triangle pairs reaching the narrow phase
+  std::uint64_t faces_apart = 0;     // ... culled whole (FeatureContext::faces_apart)
 };
 
 /// Positions of one step and the test settings.

@@ -502,6 +502,8 @@ struct ContactHandler::Impl {
         o.thickness = opt.ccd_thickness;
         o.toi_tolerance = kToiTolerance;
         o.distance_filter_depth = kFilterDepth;
+        // The proximity query below (at dh) then reuses the last CCD pass's candidate pairs.
+        o.reuse_distance = opt.thickness;
         // Seam-linked vertices count as one point: the seam's sides touch by design.
         o.linked_vertices = model.seam_links();
         self.emplace(model.topology().faces(), model.num_vertices(), x0m, o);

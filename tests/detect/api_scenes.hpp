@@ -7,6 +7,7 @@
 #include <map>
 #include <vector>
 
+#include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/oracle.hpp"
 
@@ -130,6 +131,29 @@ inline void check_pair_detector(double thickness) {
     PairDetector det(a.faces, a.nv(), a.v0, b.faces, b.nv(), b.v0, o);
     expect_pair_equal(det.detect(a.v0, a.v1, b.v0, b.v1), ref);
   }
+}
+
+// Every VF pair (v not on f) and EE pair (no shared vertex) within h, by direct distance.
+inline ProximityResult brute_force_proximity(const Topology& t, const Positions& p, double h) {
+  auto pt = [&](int v) { return Eigen::Vector3d(p.row(v).transpose()); };
+  ProximityResult r;
+  for (int v = 0; v < t.num_vertices(); ++v) {
+    for (int f = 0; f < t.num_faces(); ++f) {
+      const Face& x = t.faces()[f];
+      if (v == x[0] || v == x[1] || v == x[2]) continue;
+      const double d = point_triangle_proximity(pt(v), pt(x[0]), pt(x[1]), pt(x[2])).distance;
+      if (d <= h) r.vf.push_back({v, f, d});
+    }
+  }
+  for (int a = 0; a < t.num_edges(); ++a) {
+    for (int b = a + 1; b < t.num_edges(); ++b) {
+      const Edge &ea = t.edges()[a], &eb = t.edges()[b];
+      if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
+      const double d = edge_edge_proximity(pt(ea[0]), pt(ea[1]), pt(eb[0]), pt(eb[1])).distance;
+      if (d <= h) r.ee.push_back({a, b, d});
+    }
+  }
+  return r;
 }
 
 }  // namespace clothcd::test

@@ -27,29 +27,6 @@ using namespace clothcd::test;
 TEST(DetectApi, PairDetectorEqualsBruteForce) {
   check_pair_detector(0.0);
 }
-// Every VF pair (v not on f) and EE pair (no shared vertex) within h, by direct distance.
-ProximityResult brute_force_proximity(const Topology& t, const Positions& p, double h) {
-  auto pt = [&](int v) { return Eigen::Vector3d(p.row(v).transpose()); };
-  ProximityResult r;
-  for (int v = 0; v < t.num_vertices(); ++v) {
-    for (int f = 0; f < t.num_faces(); ++f) {
-      const Face& x = t.faces()[f];
-      if (v == x[0] || v == x[1] || v == x[2]) continue;
-      const double d = point_triangle_proximity(pt(v), pt(x[0]), pt(x[1]), pt(x[2])).distance;
-      if (d <= h) r.vf.push_back({v, f, d});
-    }
-  }
-  for (int a = 0; a < t.num_edges(); ++a) {
-    for (int b = a + 1; b < t.num_edges(); ++b) {
-      const Edge &ea = t.edges()[a], &eb = t.edges()[b];
-      if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
-      const double d = edge_edge_proximity(pt(ea[0]), pt(ea[1]), pt(eb[0]), pt(eb[1])).distance;
-      if (d <= h) r.ee.push_back({a, b, d});
-    }
-  }
-  return r;
-}
-
 TEST(DetectApi, ProximityEqualsAllPairsDistance) {
   for (const auto& s : {crumpled_sheet(8, 2), twisted_strip(30, 3), stacked_sheets(6)}) {
     const Topology topo(s.faces, s.num_vertices);

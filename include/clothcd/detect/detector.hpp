@@ -29,6 +29,9 @@ struct ProximityResult {
   };
   std::vector<VertexFace> vf;  ///< sorted by (vertex, face)
   std::vector<EdgeEdge> ee;    ///< sorted by (edge_a, edge_b)
+  /// Triangle pairs taken from the last detect() instead of a traversal (see
+  /// DetectOptions::reuse_distance); 0 when the query traversed the whole tree.
+  std::size_t reused_pairs = 0;
 };
 
 class SelfDetector {

@@ -1,0 +1,197 @@
+// DetectOptions::reuse_distance: a proximity query after a detect() that kept its triangle pairs
+// equals the all-pairs distance oracle, whether no vertex moved since, a few did (the kept pairs
+// plus a restricted traversal), most did or the query reaches farther (a full traversal); the
+// widened boxes change no CCD result; and what turns the reuse off does so.
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "api_scenes.hpp"
+#include "clothcd/core/error.hpp"
+#include "clothcd/detect/detector.hpp"
+#include "clothcd/detect/procedural.hpp"
+
+namespace clothcd {
+namespace {
+
+using namespace clothcd::test;
+
+constexpr double kKept = 0.05;  // the reuse distance of these tests
+
+// `v` with about `share` of its vertices (a seeded random choice) moved by up to `by` per axis.
+Positions moved(const Positions& v, double share, double by, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0), d(-by, by);
+  Positions out = v;
+  for (Eigen::Index i = 0; i < v.rows(); ++i) {
+    if (u(rng) >= share) continue;
+    for (int k = 0; k < 3; ++k)
+      out(i, k) += d(rng);
+  }
+  return out;
+}
+
+void expect_same(const ProximityResult& r, const ProximityResult& ref) {
+  EXPECT_EQ(vf_pairs(r.vf), vf_pairs(ref.vf));
+  EXPECT_EQ(ee_pairs(r.ee), ee_pairs(ref.ee));
+  for (std::size_t i = 0; i < std::min(r.vf.size(), ref.vf.size()); ++i)
+    EXPECT_EQ(r.vf[i].distance, ref.vf[i].distance);
+  for (std::size_t i = 0; i < std::min(r.ee.size(), ref.ee.size()); ++i)
+    EXPECT_EQ(r.ee[i].distance, ref.ee[i].distance);
+}
+
+std::vector<ProceduralScene> scenes() {
+  return {crumpled_sheet(8, 2), twisted_strip(30, 3), stacked_sheets(6)};
+}
+
+TEST(ProximityReuse, EqualsAllPairsDistance) {
+  struct Case {
+    const char* name;
+    double share;  // of the vertices moved after the detect
+    double h;
+    bool reused;
+  };
+  const Case cases[] = {
+      {"none moved", 0.0, kKept, true},  {"none moved, nearer", 0.0, 0.01, true},
+      {"a few moved", 0.1, 0.01, true},  {"a few moved, at the kept distance", 0.1, kKept, true},
+      {"most moved", 0.6, kKept, false}, {"farther than kept", 0.0, 1.2 * kKept, false}};
+  for (const auto& s : scenes()) {
+    const Topology topo(s.faces, s.num_vertices);
+    const Positions end = 0.5 * (s.v_t0 + s.v_t1);  // folded: features come close
+    for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+      DetectOptions plain;
+      plain.build = build;
+      DetectOptions o = plain;
+      o.reuse_distance = kKept;
+      SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+      SelfDetector ref_det(s.faces, s.num_vertices, s.v_t0, plain);
+      // The widened boxes find the same collisions, on the whole step and on its first half.
+      for (const Positions* to : {&s.v_t1, &end}) {
+        const DetectResult a = det.detect(s.v_t0, *to);
+        const DetectResult b = ref_det.detect(s.v_t0, *to);
+        EXPECT_EQ(a.vf, b.vf) << s.name;
+        EXPECT_EQ(a.ee, b.ee) << s.name;
+        if (to == &s.v_t1) EXPECT_GT(a.vf.size() + a.ee.size(), 0u) << s.name;
+      }
+      std::uint32_t seed = 1;
+      for (const Case& c : cases) {
+        SCOPED_TRACE(::testing::Message() << s.name << " build " << int(build) << ": " << c.name);
+        static_cast<void>(det.detect(s.v_t0, end));
+        const Positions v = moved(end, c.share, 0.02, seed++);
+        const ProximityResult r = det.proximity(v, c.h);
+        const ProximityResult ref = brute_force_proximity(topo, v, c.h);
+        EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u);
+        expect_same(r, ref);
+        EXPECT_EQ(r.reused_pairs > 0, c.reused) << r.reused_pairs;
+      }
+    }
+  }
+}
+
+// A simulator's passes: an unrestricted detect keeps its pairs, restricted ones after it (the
+// active vertices moved again) keep them too, and the next proximity query reuses them. Also
+// with the simulator's options: a CCD thickness, and Sound culling (no cone culls with it).
+TEST(ProximityReuse, KeptAcrossRestrictedPasses) {
+  DetectOptions thick;
+  thick.culling = Culling::Sound;
+  thick.thickness = 1e-3;
+  for (const auto& s : scenes()) {
+    for (DetectOptions o : {DetectOptions{}, thick}) {
+      SCOPED_TRACE(::testing::Message() << s.name << " thickness " << o.thickness);
+      const Topology topo(s.faces, s.num_vertices);
+      const Positions end = 0.5 * (s.v_t0 + s.v_t1);
+      o.reuse_distance = kKept;
+      SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+      static_cast<void>(det.detect(s.v_t0, end));
+      std::vector<int> active;
+      Positions later = end;
+      for (int v = 0; v < s.num_vertices; v += 9) {
+        active.push_back(v);
+        later.row(v) += Eigen::RowVector3d(0.01, -0.015, 0.02);
+      }
+      det.set_active_vertices(active);
+      static_cast<void>(det.detect(s.v_t0, later));
+      det.clear_active_faces();
+      const ProximityResult r = det.proximity(later, kKept);
+      EXPECT_GT(r.reused_pairs, 0u);
+      expect_same(r, brute_force_proximity(topo, later, kKept));
+      // The same answer on 1 and 3 threads.
+      for (int threads : {1, 3}) {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        static_cast<void>(det.detect(s.v_t0, end));
+        const ProximityResult t = det.proximity(later, kKept);
+        EXPECT_GT(t.reused_pairs, 0u);
+        expect_same(t, r);
+      }
+    }
+  }
+}
+
+TEST(ProximityReuse, OffWhereItCannotHold) {
+  const ProceduralScene s = crumpled_sheet(8, 2);
+  const Topology topo(s.faces, s.num_vertices);
+  const Positions end = 0.5 * (s.v_t0 + s.v_t1);
+  const ProximityResult ref = brute_force_proximity(topo, end, kKept);
+  DetectOptions o;
+  o.reuse_distance = kKept;
+  {
+    SCOPED_TRACE("no detect yet");
+    SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+    const ProximityResult r = det.proximity(end, kKept);
+    EXPECT_EQ(r.reused_pairs, 0u);
+    expect_same(r, ref);
+  }
+  {
+    SCOPED_TRACE("options set again");
+    SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+    static_cast<void>(det.detect(s.v_t0, end));
+    det.set_options(o);
+    const ProximityResult r = det.proximity(end, kKept);
+    EXPECT_EQ(r.reused_pairs, 0u);
+    expect_same(r, ref);
+  }
+  {
+    SCOPED_TRACE("cone culling (zero thickness) lists fewer pairs than the boxes overlap");
+    DetectOptions sound = o;
+    sound.culling = Culling::Sound;
+    SelfDetector det(s.faces, s.num_vertices, s.v_t0, sound);
+    static_cast<void>(det.detect(s.v_t0, end));
+    const ProximityResult r = det.proximity(end, kKept);
+    EXPECT_EQ(r.reused_pairs, 0u);
+    expect_same(r, ref);
+  }
+  {
+    SCOPED_TRACE("a query under an active restriction keeps its scope");
+    DetectOptions plain;
+    SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+    SelfDetector ref_det(s.faces, s.num_vertices, s.v_t0, plain);
+    static_cast<void>(det.detect(s.v_t0, end));
+    const std::vector<int> active{0, 5, 17, 40};
+    det.set_active_vertices(active);
+    ref_det.set_active_vertices(active);
+    const ProximityResult r = det.proximity(end, kKept);
+    const ProximityResult r_ref = ref_det.proximity(end, kKept);
+    EXPECT_EQ(r.reused_pairs, 0u);
+    expect_same(r, r_ref);
+    EXPECT_LT(r.vf.size() + r.ee.size(), ref.vf.size() + ref.ee.size());
+  }
+}
+
+TEST(ProximityReuse, RejectsBadDistances) {
+  const ProceduralScene s = crumpled_sheet(4, 1);
+  for (double d :
+       {-1e-3, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    DetectOptions o;
+    o.reuse_distance = d;
+    EXPECT_THROW(SelfDetector(s.faces, s.num_vertices, s.v_t0, o), InputError) << d;
+    SelfDetector det(s.faces, s.num_vertices, s.v_t0);
+    EXPECT_THROW(det.set_options(o), InputError) << d;
+  }
+}
+
+}  // namespace
+}  // namespace clothcd
