@@ -58,7 +58,7 @@ double triangle_triangle_bound(const Triangle& a, const Triangle& b) {
 }
 
 bool triangles_filter_culls(const Triangle& a_t0, const Triangle& a_t1, const Triangle& b_t0,
-                            const Triangle& b_t1, double thickness) {
+                            const Triangle& b_t1, double thickness, double* bound_t1) {
   double move2 = 0.0;
   for (int i = 0; i < 3; ++i) {
     const Vec3 da = *a_t1[i] - *a_t0[i];
@@ -69,8 +69,9 @@ bool triangles_filter_culls(const Triangle& a_t0, const Triangle& a_t1, const Tr
   // the feature pairs (theirs are taken over fewer points).
   const double s0 = slack(a_t0, b_t0), s1 = slack(a_t1, b_t1);
   const double eps = std::max(s0, s1);
-  const double bound =
-      0.5 * (bound_less(a_t0, b_t0, s0) + bound_less(a_t1, b_t1, s1) - std::sqrt(move2));
+  const double d1 = bound_less(a_t1, b_t1, s1);
+  if (bound_t1 != nullptr) *bound_t1 = d1;
+  const double bound = 0.5 * (bound_less(a_t0, b_t0, s0) + d1 - std::sqrt(move2));
   return std::isfinite(bound) && bound > thickness + eps;
 }
 

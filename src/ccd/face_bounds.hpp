@@ -29,8 +29,9 @@ inline Triangle corners(std::span<const Eigen::Vector3d> x, const std::array<int
 /// bound at both ends and D the largest relative displacement of a vertex of a against one of b.
 /// Each feature pair's own distances are at least these bounds and its own D at most this D, so
 /// where this culls, each of them culls as well.
+/// `bound_t1`, when given, receives triangle_triangle_bound(a_t1, b_t1), computed on the way.
 [[nodiscard]] bool triangles_filter_culls(const Triangle& a_t0, const Triangle& a_t1,
                                           const Triangle& b_t0, const Triangle& b_t1,
-                                          double thickness);
+                                          double thickness, double* bound_t1 = nullptr);
 
 }  // namespace clothcd::detail

@@ -69,8 +69,9 @@ struct SelfDetector::Impl {
   bool links_current = false;
   detail::Ownership owner;
   // The triangle pairs of the last unrestricted detect() with boxes widened to
-  // opt.reuse_distance, and its positions at t1: a proximity query at most that far needs no
-  // traversal for the vertices still there (see DetectOptions::reuse_distance).
+  // opt.reuse_distance that are at most that far apart at t1 (the others' features are farther,
+  // wherever their vertices still are), and its positions at t1: a proximity query at most that
+  // far needs no traversal for the vertices still there (see DetectOptions::reuse_distance).
   struct Reuse {
     bool valid = false;
     std::vector<Eigen::Vector3d> x1;
@@ -172,10 +173,13 @@ struct SelfDetector::Impl {
   }
 
   // The feature pairs of `pairs` and of the orphans that collide (ctx's boxes are up to date).
+  // With `near`, also flags the pairs whose faces are at most opt.reuse_distance apart at t1.
   void narrow(const detail::FeatureContext& ctx, const std::vector<std::pair<int, int>>& pairs,
-              DetectResult& res) {
+              DetectResult& res, std::vector<std::uint8_t>* near = nullptr) {
     tbb::enumerable_thread_specific<NarrowBuffer> locals;
     const bool wide = widened();
+    if (near != nullptr) near->assign(pairs.size(), 0);
+    const auto& faces = topo.faces();
     auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
     auto kee = [&](int a, int b, NarrowBuffer& out) { ctx.kernel_ee(a, b, out.c, out.ee); };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
@@ -184,9 +188,20 @@ struct SelfDetector::Impl {
                         for (std::size_t i = r.begin(); i != r.end(); ++i) {
                           const auto [f, g] = pairs[i];
                           // Widened leaf boxes: no feature pair of faces whose own boxes miss.
-                          if (wide && !detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) continue;
+                          if (wide && !detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) {
+                            if (near != nullptr) {
+                              (*near)[i] =
+                                  !(detail::triangle_triangle_bound(detail::corners(v1, faces[f]),
+                                                                    detail::corners(v1, faces[g])) >
+                                    opt.reuse_distance);
+                            }
+                            continue;
+                          }
                           ++out.c.triangle_pairs;
-                          if (ctx.faces_apart(f, g)) {
+                          double d1 = 0.0;
+                          const bool apart = ctx.faces_apart(f, g, near != nullptr ? &d1 : nullptr);
+                          if (near != nullptr) (*near)[i] = !(d1 > opt.reuse_distance);
+                          if (apart) {
                             ++out.c.faces_apart;
                             continue;
                           }
@@ -295,11 +310,16 @@ struct SelfDetector::Impl {
     t = Clock::now();
     detail::FeatureContext ctx = ccd_context();
     boxes.update(ctx);
-    narrow(ctx, pairs, res);
+    const bool keep = widened() && !restricted;
+    std::vector<std::uint8_t> near;
+    narrow(ctx, pairs, res, keep ? &near : nullptr);
     st.time_narrow = seconds_since(t);
-    if (widened() && !restricted) {
+    if (keep) {
       reuse.x1 = v1;
-      reuse.pairs = std::move(pairs);
+      reuse.pairs.clear();
+      for (std::size_t i = 0; i < pairs.size(); ++i) {
+        if (near[i] != 0) reuse.pairs.push_back(pairs[i]);
+      }
       reuse.valid = true;
     }
 

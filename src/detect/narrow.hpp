@@ -123,12 +123,17 @@ struct FeatureContext {
   /// whole triangles, triangles_filter_culls); false where that filter is not the one in use.
   /// A triangle pair of two layers resting on each other is mostly this: one plane keeps the
   /// other face on its side, and 15 feature bounds reduce to one.
-  [[nodiscard]] bool faces_apart(int f, int g) const {
-    if (!distance_filter()) return false;
+  /// `bound_t1`, when given, receives triangle_triangle_bound of the faces at t1 (computed here
+  /// even where the filter is not in use).
+  [[nodiscard]] bool faces_apart(int f, int g, double* bound_t1 = nullptr) const {
     const Face& a = topo->faces()[f];
     const Face& b = topo->faces()[g];
+    if (!distance_filter()) {
+      if (bound_t1 != nullptr) *bound_t1 = triangle_triangle_bound(corners(v1, a), corners(v1, b));
+      return false;
+    }
     return triangles_filter_culls(corners(v0, a), corners(v1, a), corners(v0, b), corners(v1, b),
-                                  ccd.thickness);
+                                  ccd.thickness, bound_t1);
   }
 
   /// Vertex v against face f (their boxes already overlap): NP filter, then the kernel.
