@@ -75,7 +75,9 @@ TEST(ProximityReuse, EqualsAllPairsDistance) {
         const DetectResult b = ref_det.detect(s.v_t0, *to);
         EXPECT_EQ(a.vf, b.vf) << s.name;
         EXPECT_EQ(a.ee, b.ee) << s.name;
-        if (to == &s.v_t1) EXPECT_GT(a.vf.size() + a.ee.size(), 0u) << s.name;
+        if (to == &s.v_t1) {
+          EXPECT_GT(a.vf.size() + a.ee.size(), 0u) << s.name;
+        }
       }
       std::uint32_t seed = 1;
       for (const Case& c : cases) {
