@@ -48,7 +48,8 @@ class SelfDetector {
   /// sorted and do not depend on the number of threads.
   [[nodiscard]] DetectResult detect(const Positions& v_t0, const Positions& v_t1);
 
-  /// VF and EE pairs closer than h at positions v (box culling only).
+  /// VF and EE pairs closer than h at positions v (box culling only). After a detect() with
+  /// DetectOptions::reuse_distance >= h, it starts from that call's pairs (the same results).
   [[nodiscard]] ProximityResult proximity(const Positions& v, double h);
 
   /// Restricts detection to pairs in which at least one feature belongs to an active triangle.
