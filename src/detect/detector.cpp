@@ -91,10 +91,11 @@ struct SelfDetector::Impl {
     return mode != Culling::None && !(mode == Culling::Sound && opt.thickness > 0);
   }
 
-  // Boxes widened for reuse: only when no cone culls, so the traversal lists every overlapping
-  // leaf pair.
-  [[nodiscard]] bool widened() const {
-    return opt.reuse_distance > opt.thickness && !cones_used(opt.culling);
+  // Pairs kept for reuse: only when no cone culls, so the traversal lists every overlapping leaf
+  // pair; the boxes then reach at least reuse_distance.
+  [[nodiscard]] bool keeps() const { return opt.reuse_distance > 0 && !cones_used(opt.culling); }
+  [[nodiscard]] double box_reach() const {
+    return keeps() ? std::max(opt.thickness, opt.reuse_distance) : opt.thickness;
   }
 
   [[nodiscard]] bool vf_in_scope(int v, int f) const {
@@ -177,7 +178,7 @@ struct SelfDetector::Impl {
   void narrow(const detail::FeatureContext& ctx, const std::vector<std::pair<int, int>>& pairs,
               DetectResult& res, std::vector<std::uint8_t>* near = nullptr) {
     tbb::enumerable_thread_specific<NarrowBuffer> locals;
-    const bool wide = widened();
+    const bool wide = box_reach() > opt.thickness;
     if (near != nullptr) near->assign(pairs.size(), 0);
     const auto& faces = topo.faces();
     auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
@@ -295,7 +296,7 @@ struct SelfDetector::Impl {
     DetectStats& st = res.stats;
     auto t = Clock::now();
     RefitOptions ro;
-    ro.thickness = widened() ? opt.reuse_distance : opt.thickness;
+    ro.thickness = box_reach();
     ro.cones = cones_used(opt.culling);
     ro.policy = opt.policy;
     bvh.refit_changed(v0, v1, ro);
@@ -310,7 +311,7 @@ struct SelfDetector::Impl {
     t = Clock::now();
     detail::FeatureContext ctx = ccd_context();
     boxes.update(ctx);
-    const bool keep = widened() && !restricted;
+    const bool keep = keeps() && !restricted;
     std::vector<std::uint8_t> near;
     narrow(ctx, pairs, res, keep ? &near : nullptr);
     st.time_narrow = seconds_since(t);
@@ -428,7 +429,7 @@ struct SelfDetector::Impl {
   // Whether proximity(v0, h) can use the kept pairs: then the active restriction is set to the
   // vertices that moved since (few, or the traversal is cheaper).
   bool reusable(double h) {
-    if (!reuse.valid || restricted || h > opt.reuse_distance || !widened()) return false;
+    if (!reuse.valid || restricted || h > opt.reuse_distance || !keeps()) return false;
     const int nv = topo.num_vertices();
     std::vector<int> moved;
     for (int i = 0; i < nv; ++i) {

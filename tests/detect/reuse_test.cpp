@@ -133,6 +133,32 @@ TEST(ProximityReuse, KeptAcrossRestrictedPasses) {
   }
 }
 
+// A CCD thickness at or above the reuse distance already gives boxes wide enough: the pairs are
+// kept all the same, and the collisions are those of a detector without reuse.
+TEST(ProximityReuse, KeptWhenTheThicknessAlreadyReachesTheDistance) {
+  const ProceduralScene s = crumpled_sheet(8, 2);
+  const Topology topo(s.faces, s.num_vertices);
+  const Positions end = 0.5 * (s.v_t0 + s.v_t1);
+  for (double reach : {kKept, 0.5 * kKept}) {
+    SCOPED_TRACE(::testing::Message() << "reuse distance " << reach);
+    DetectOptions plain;
+    plain.culling = Culling::Sound;
+    plain.thickness = kKept;
+    DetectOptions o = plain;
+    o.reuse_distance = reach;
+    SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+    SelfDetector ref_det(s.faces, s.num_vertices, s.v_t0, plain);
+    const DetectResult a = det.detect(s.v_t0, end);
+    const DetectResult b = ref_det.detect(s.v_t0, end);
+    EXPECT_EQ(a.vf, b.vf);
+    EXPECT_EQ(a.ee, b.ee);
+    const Positions v = moved(end, 0.1, 0.02, 7);
+    const ProximityResult r = det.proximity(v, reach);
+    EXPECT_GT(r.reused_pairs, 0u);
+    expect_same(r, brute_force_proximity(topo, v, reach));
+  }
+}
+
 TEST(ProximityReuse, OffWhereItCannotHold) {
   const ProceduralScene s = crumpled_sheet(8, 2);
   const Topology topo(s.faces, s.num_vertices);

@@ -36,9 +36,9 @@ struct DetectOptions {
   /// Bisections of the distance filter (`distance_filter_culls` depth) when thickness > 0: each
   /// level can cull near misses the whole-step bound cannot, before the costlier kernel runs.
   int distance_filter_depth = 0;
-  /// A simulator's shortcut, results unchanged: when larger than `thickness` (and no cone culls),
-  /// an unrestricted detect() widens its candidate boxes to this distance and keeps its triangle
-  /// pairs, so that a following proximity(v, h) with h <= reuse_distance traverses only near the
+  /// A simulator's shortcut, results unchanged: when > 0 (and no cone culls), an unrestricted
+  /// detect() widens its candidate boxes to at least this distance and keeps its triangle pairs,
+  /// so that a following proximity(v, h) with h <= reuse_distance traverses only near the
   /// vertices whose position in v differs from theirs at t1 (all of them when over a quarter do).
   double reuse_distance = 0.0;
   /// Also run the unculled traversal and report what the culled one missed.
