@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <limits>
 #include <ostream>
 #include <string>
@@ -51,7 +52,8 @@ struct Pending {
 
 class ObjParser {
  public:
-  explicit ObjParser(std::string file) : file_(std::move(file)) {}
+  explicit ObjParser(std::string file, bool vertices_only = false)
+      : file_(std::move(file)), vertices_only_(vertices_only) {}
 
   ObjContents parse(std::string_view text) {
     std::size_t pos = 0;
@@ -69,6 +71,15 @@ class ObjParser {
                                         p.index + 1, nv));
       }
     }
+    const long long nt = static_cast<long long>(out_.texcoords.size());
+    for (const Pending& p : pending_texcoords_) {
+      if (p.index >= nt) {
+        throw error(p.line, fmt::format("texture index {} is out of range: the file has {} texture "
+                                        "coordinates",
+                                        p.index + 1, nt));
+      }
+    }
+    if (vertices_only_) return std::move(out_);
     for (const auto& [line, s] : stitch_lines_) {
       for (int v : {s.i, s.j, s.k}) {
         if (v >= nv) {
@@ -92,6 +103,15 @@ class ObjParser {
   }
 
   void parse_line(std::string_view line) {
+    if (vertices_only_) {
+      // Only `v` lines count: skip the others before scanning them (an animation frame is
+      // mostly faces).
+      const std::size_t first = line.find_first_not_of(" \t");
+      if (first == std::string_view::npos || line[first] != 'v' || first + 1 >= line.size() ||
+          (line[first + 1] != ' ' && line[first + 1] != '\t')) {
+        return;
+      }
+    }
     if (line.find('\0') != std::string_view::npos) {
       throw error(line_, "contains a NUL byte: expected a text OBJ file");
     }
@@ -103,13 +123,36 @@ class ObjParser {
     const std::string_view key = tokens_.items[0];
     if (key == "v") {
       parse_vertex();
+    } else if (vertices_only_) {
+      return;
+    } else if (key == "vt") {
+      parse_texcoord();
     } else if (key == "f") {
       parse_face();
     } else if (key == "stitch") {
       parse_stitch();
     }
-    // Other statements (vt, vn, g, o, s, usemtl, l, seam, ...) carry nothing a collision
-    // detector needs.
+    // Other statements (vn, g, o, s, usemtl, l, seam, ...) carry nothing a collision detector
+    // or the simulator needs.
+  }
+
+  void parse_texcoord() {
+    // u v, optionally w.
+    if (tokens_.count < 3 || tokens_.count > 4) {
+      throw error(line_, fmt::format("texture coordinate line has {} numbers, expected 2 (u v)",
+                                     tokens_.count - 1));
+    }
+    double uv[3];
+    for (int i = 1; i < tokens_.count; ++i) {
+      if (!parse_double(tokens_.items[i], uv[i - 1])) {
+        throw error(line_,
+                    fmt::format("texture coordinate '{}' is not a number", tokens_.items[i]));
+      }
+      if (!std::isfinite(uv[i - 1])) {
+        throw error(line_, fmt::format("texture coordinate '{}' is not finite", tokens_.items[i]));
+      }
+    }
+    out_.texcoords.emplace_back(uv[0], uv[1]);
   }
 
   void parse_vertex() {
@@ -135,8 +178,36 @@ class ObjParser {
     out_.mesh.vertices.emplace_back(xyz[0], xyz[1], xyz[2]);
   }
 
-  int vertex_reference(std::string_view token) {
-    // v, v/t, v//n or v/t/n: only v matters, but every part must be an integer.
+  // A corner's vertex index (resolved, 0-based) and its texture index (-1 when it names none).
+  struct Corner {
+    int vertex;
+    int texcoord;
+  };
+
+  // A 1-based or relative (negative) OBJ index against `count` items so far; an absolute index
+  // past them is checked once the file is read (`pending`).
+  int resolve(long long index, long long count, const char* what, std::vector<Pending>& pending) {
+    if (index == 0) {
+      throw error(line_, fmt::format("{} index 0 is invalid: OBJ indices start at 1", what));
+    }
+    if (index < 0) {
+      // Relative reference: -1 is the latest one.
+      if (-index > count) {
+        throw error(line_, fmt::format("relative {0} index {1} reaches before the first {0} ({2} "
+                                       "defined so far)",
+                                       what, index, count));
+      }
+      return static_cast<int>(count + index);
+    }
+    if (index > std::numeric_limits<int>::max()) {
+      throw error(line_, fmt::format("{} index {} is out of range", what, index));
+    }
+    if (index > count) pending.push_back({line_, index - 1});
+    return static_cast<int>(index - 1);
+  }
+
+  Corner vertex_reference(std::string_view token) {
+    // v, v/t, v//n or v/t/n: v and t matter, but every part must be an integer.
     std::string_view parts[3];
     int num_parts = 0;
     std::size_t start = 0;
@@ -154,28 +225,22 @@ class ObjParser {
     if (!parse_int(parts[0], index)) {
       throw error(line_, fmt::format("face corner '{}' is not a vertex index (an integer)", token));
     }
+    long long texture = 0;  // 0: none
     for (int p = 1; p < num_parts; ++p) {
-      long long ignored = 0;
-      if (!(parts[p].empty() && p == 1 && num_parts == 3) && !parse_int(parts[p], ignored)) {
+      long long value = 0;
+      if (!(parts[p].empty() && p == 1 && num_parts == 3) && !parse_int(parts[p], value)) {
         throw error(line_, fmt::format("face corner '{}' is malformed", token));
       }
+      if (p == 1) texture = value;
     }
-    const long long nv = static_cast<long long>(out_.mesh.vertices.size());
-    if (index == 0) throw error(line_, "vertex index 0 is invalid: OBJ indices start at 1");
-    if (index < 0) {
-      // Relative reference: -1 is the latest vertex.
-      if (-index > nv) {
-        throw error(line_, fmt::format("relative vertex index {} reaches before the first vertex "
-                                       "({} vertices defined so far)",
-                                       index, nv));
-      }
-      return static_cast<int>(nv + index);
-    }
-    if (index > std::numeric_limits<int>::max()) {
-      throw error(line_, fmt::format("vertex index {} is out of range", index));
-    }
-    if (index > nv) pending_.push_back({line_, index - 1});
-    return static_cast<int>(index - 1);
+    Corner c{};
+    c.vertex =
+        resolve(index, static_cast<long long>(out_.mesh.vertices.size()), "vertex", pending_);
+    c.texcoord = num_parts >= 2 && !parts[1].empty()
+                     ? resolve(texture, static_cast<long long>(out_.texcoords.size()), "texture",
+                               pending_texcoords_)
+                     : -1;
+    return c;
   }
 
   void parse_face() {
@@ -187,9 +252,12 @@ class ObjParser {
       throw error(line_, fmt::format("face has {} corners, at most {} supported", corners,
                                      Tokens::kMax - 1));
     }
-    int ids[Tokens::kMax];
-    for (int c = 0; c < corners; ++c)
-      ids[c] = vertex_reference(tokens_.items[c + 1]);
+    int ids[Tokens::kMax], tex[Tokens::kMax];
+    for (int c = 0; c < corners; ++c) {
+      const Corner corner = vertex_reference(tokens_.items[c + 1]);
+      ids[c] = corner.vertex;
+      tex[c] = corner.texcoord;
+    }
     for (int a = 0; a < corners; ++a) {
       for (int b = a + 1; b < corners; ++b) {
         if (ids[a] == ids[b]) {
@@ -198,8 +266,10 @@ class ObjParser {
         }
       }
     }
-    for (int c = 1; c + 1 < corners; ++c)
+    for (int c = 1; c + 1 < corners; ++c) {
       out_.mesh.faces.push_back({ids[0], ids[c], ids[c + 1]});
+      out_.face_texcoords.push_back({tex[0], tex[c], tex[c + 1]});
+    }
   }
 
   void parse_stitch() {
@@ -226,10 +296,11 @@ class ObjParser {
   }
 
   std::string file_;
+  bool vertices_only_ = false;
   std::size_t line_ = 0;
   Tokens tokens_;
   ObjContents out_;
-  std::vector<Pending> pending_;
+  std::vector<Pending> pending_, pending_texcoords_;
   std::vector<std::pair<std::size_t, Stitch>> stitch_lines_;
 };
 
@@ -242,6 +313,11 @@ ObjContents read_obj_with_stitches(const std::filesystem::path& path) {
 
 TriangleMesh read_obj(const std::filesystem::path& path) {
   return read_obj_with_stitches(path).mesh;
+}
+
+std::vector<Eigen::Vector3d> read_obj_vertices(const std::filesystem::path& path) {
+  const std::string text = io_detail::read_file(path);
+  return ObjParser(path.string(), true).parse(text).mesh.vertices;
 }
 
 void write_obj(const std::filesystem::path& path, const TriangleMesh& mesh) {

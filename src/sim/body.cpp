@@ -7,7 +7,7 @@
 #include <map>
 
 #include "clothcd/core/error.hpp"
-#include "clothcd/sim/obj_reader.hpp"
+#include "clothcd/mesh/io.hpp"
 
 namespace clothcd::sim {
 
@@ -15,9 +15,9 @@ MeshSequenceBody::MeshSequenceBody(std::vector<std::filesystem::path> frames, do
                                    const Vec3& offset)
     : paths_(std::move(frames)), frame_dt_(frame_dt), offset_(offset) {
   if (paths_.empty()) throw InputError("body: no frames given");
-  const ObjData first = read_obj(paths_[0]);
+  const TriangleMesh first = read_obj(paths_[0]);
   faces_ = first.faces;
-  num_vertices_ = static_cast<int>(first.positions.size());
+  num_vertices_ = first.num_vertices();
 }
 
 const std::vector<Vec3>& MeshSequenceBody::frame(int k, int keep) {
@@ -25,7 +25,7 @@ const std::vector<Vec3>& MeshSequenceBody::frame(int k, int keep) {
     if (cached_[s] == k) return cache_[s];
   }
   const int s = cached_[0] == keep ? 1 : 0;  // never evict the frame the caller still reads
-  cache_[s] = read_obj_positions(paths_[k]);
+  cache_[s] = read_obj_vertices(paths_[k]);
   if (static_cast<int>(cache_[s].size()) != num_vertices_) {
     cached_[s] = -1;
     throw input_error(

@@ -11,7 +11,7 @@
 #include <set>
 
 #include "clothcd/core/error.hpp"
-#include "clothcd/sim/obj_reader.hpp"
+#include "clothcd/mesh/io.hpp"
 #include "clothcd/sim/sewing.hpp"
 
 namespace clothcd::sim {
@@ -165,13 +165,12 @@ GridInfo read_grid(ObjectReader g, ClothMeshInput& cloth) {
 
 void read_obj_cloth(ObjectReader& c, ClothMeshInput& cloth) {
   const std::filesystem::path obj_path = resolve_path(c, "obj");
-  ObjData obj = read_obj(obj_path);
-  const int nv = c.integer("vertices", static_cast<int>(obj.positions.size()), 3,
-                           static_cast<int>(obj.positions.size()));
-  obj.positions.resize(nv);
+  TriangleMesh obj = read_obj(obj_path);
+  const int nv = c.integer("vertices", obj.num_vertices(), 3, obj.num_vertices());
+  obj.vertices.resize(nv);
   int nf = 0;
-  while (nf < static_cast<int>(obj.faces.size()) && obj.faces[nf][0] < nv &&
-         obj.faces[nf][1] < nv && obj.faces[nf][2] < nv) {
+  while (nf < obj.num_faces() && obj.faces[nf][0] < nv && obj.faces[nf][1] < nv &&
+         obj.faces[nf][2] < nv) {
     ++nf;
   }
   if (c.has("faces")) {
@@ -184,31 +183,31 @@ void read_obj_cloth(ObjectReader& c, ClothMeshInput& cloth) {
   }
   obj.faces.resize(nf);
   const Vec3 t = c.vec3("translate", Vec3::Zero());
-  for (Vec3& p : obj.positions)
+  for (Vec3& p : obj.vertices)
     p += t;
-  cloth.positions = std::move(obj.positions);
+  cloth.positions = std::move(obj.vertices);
   cloth.faces = std::move(obj.faces);
 
   const std::string rest = c.string("rest", "initial", {"initial", "pattern"});
   const std::string stitches = c.string("stitches", "none", {"none", "pattern", "recover"});
-  ObjData pattern;
+  ObjContents pattern;
   if (rest == "pattern" || stitches == "pattern") {
     const std::filesystem::path pp = resolve_path(c, "pattern");
-    pattern = read_obj(pp);
-    if (static_cast<int>(pattern.positions.size()) != nv) {
+    pattern = read_obj_with_stitches(pp);
+    if (pattern.mesh.num_vertices() != nv) {
       c.fail(c.key("pattern"), fmt::format("{} has {} vertices, the cloth has {}", pp.string(),
-                                           pattern.positions.size(), nv));
+                                           pattern.mesh.num_vertices(), nv));
     }
     if (rest == "pattern") {
-      if (pattern.faces.size() != cloth.faces.size()) {
+      if (pattern.mesh.faces.size() != cloth.faces.size()) {
         c.fail(c.key("pattern"), fmt::format("{} has {} faces, the cloth has {}", pp.string(),
-                                             pattern.faces.size(), cloth.faces.size()));
+                                             pattern.mesh.faces.size(), cloth.faces.size()));
       }
       cloth.pattern.assign(nv, Vec2::Zero());
       std::vector<bool> seen(nv, false);
-      for (std::size_t f = 0; f < pattern.faces.size(); ++f) {
+      for (std::size_t f = 0; f < pattern.mesh.faces.size(); ++f) {
         for (int k = 0; k < 3; ++k) {
-          const int v = pattern.faces[f][k], vt = pattern.face_texcoords[f][k];
+          const int v = pattern.mesh.faces[f][k], vt = pattern.face_texcoords[f][k];
           if (vt < 0 || v != cloth.faces[f][k]) {
             c.fail(c.key("pattern"), fmt::format("{}: face {} must match the cloth's face and "
                                                  "carry texture coordinates",
@@ -221,7 +220,8 @@ void read_obj_cloth(ObjectReader& c, ClothMeshInput& cloth) {
     }
     if (stitches == "pattern") {
       if (pattern.stitches.empty()) c.fail(c.key("pattern"), pp.string() + " has no stitch lines");
-      cloth.stitches = pattern.stitches;
+      for (const clothcd::Stitch& st : pattern.stitches)
+        cloth.stitches.push_back({st.i, st.j, st.k, st.r});
     }
   }
   const double recover = c.number("recover_distance", 1e-3, 0.0, 0.1);

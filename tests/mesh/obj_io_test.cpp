@@ -44,6 +44,33 @@ TEST(ObjRead, FourthCoordinateAndColoursAccepted) {
   EXPECT_EQ(read_obj(p).num_vertices(), 3);
 }
 
+TEST(ObjRead, TextureCoordinatesPerCorner) {
+  // A quad fanned into two triangles keeps each corner's texture index; a corner without one
+  // gets -1, a relative one resolves like a vertex index, a forward one is checked at the end.
+  ScratchDir dir;
+  const auto p = dir.file("t.obj", std::string(kSquare) +
+                                       "vt 0 0\nvt 1 0\nvt 1 1 0\nf 1/1 2/2 3/-2 4/4\nf 1 2 4\n"
+                                       "vt 0 1\n");
+  const ObjContents c = read_obj_with_stitches(p);
+  ASSERT_EQ(c.texcoords.size(), 4u);
+  EXPECT_EQ(c.texcoords[2], Eigen::Vector2d(1, 1));
+  EXPECT_EQ(c.mesh.faces, (std::vector<Face>{{0, 1, 2}, {0, 2, 3}, {0, 1, 3}}));
+  EXPECT_EQ(c.face_texcoords, (std::vector<Face>{{0, 1, 1}, {0, 1, 3}, {-1, -1, -1}}));
+  EXPECT_EQ(read_obj(p), c.mesh);
+}
+
+TEST(ObjRead, VerticesOnlyReadsTheVertexLines) {
+  // Faces are neither read nor needed (an animation frame after the first); vertices are
+  // checked as read_obj checks them.
+  ScratchDir dir;
+  const auto p = dir.file("v.obj", std::string(kSquare) + "f 1 2 9\nvt x y\n  v 2 0 0\n");
+  EXPECT_EQ(read_obj_vertices(p),
+            (std::vector<Eigen::Vector3d>{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 0}}));
+  const auto q = dir.file("w.obj", "v 0 0 0\nv 1 x 0\n");
+  expect_input_error([&] { (void)read_obj_vertices(q); }, {"w.obj:2:", "'x' is not a number"});
+  expect_input_error([&] { (void)read_obj_vertices(dir.path() / "missing.obj"); }, {"missing.obj"});
+}
+
 TEST(ObjReadErrors, MissingFile) {
   ScratchDir dir;
   expect_input_error([&] { (void)read_obj(dir.path() / "nope.obj"); }, {"nope.obj", "no such"});
@@ -150,6 +177,19 @@ TEST(ObjReadErrors, FaceRepeatsVertex) {
   ScratchDir dir;
   const auto p = dir.file("rep.obj", std::string(kSquare) + "f 1 2 3\nf 1 2 -4\n");
   expect_input_error([&] { (void)read_obj(p); }, {"rep.obj:6:", "repeats vertex 1"});
+}
+
+TEST(ObjReadErrors, TextureCoordinates) {
+  ScratchDir dir;
+  auto p = dir.file("a.obj", std::string(kSquare) + "vt 0\nf 1 2 3\n");
+  expect_input_error([&] { (void)read_obj(p); }, {"a.obj:5:", "expected 2 (u v)"});
+  p = dir.file("b.obj", std::string(kSquare) + "vt 0 inf\nf 1 2 3\n");
+  expect_input_error([&] { (void)read_obj(p); }, {"b.obj:5:", "'inf' is not finite"});
+  p = dir.file("c.obj", std::string(kSquare) + "vt 0 0\nf 1/2 2/1 3/1\n");
+  expect_input_error([&] { (void)read_obj(p); },
+                     {"c.obj:6:", "texture index 2 is out of range: the file has 1 texture"});
+  p = dir.file("d.obj", std::string(kSquare) + "f 1/-1 2 3\n");
+  expect_input_error([&] { (void)read_obj(p); }, {"d.obj:5:", "relative texture index -1"});
 }
 
 TEST(ObjReadErrors, BinaryData) {

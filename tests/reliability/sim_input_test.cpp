@@ -1,5 +1,6 @@
-// Regression tests for the simulator's own readers (OBJ for cloth, pattern and body frames; scene
-// JSON), for the input classes the fuzz targets fuzz_sim_obj and fuzz_scene check.
+// Regression tests for the simulator's inputs (OBJ for cloth, pattern and body frames, read with
+// the mesh module's reader; scene JSON), for the input classes the fuzz targets fuzz_obj and
+// fuzz_scene check.
 
 #include <gtest/gtest.h>
 
@@ -10,7 +11,7 @@
 
 #include "cli_runner.hpp"
 #include "clothcd/core/error.hpp"
-#include "clothcd/sim/obj_reader.hpp"
+#include "clothcd/mesh/io.hpp"
 #include "clothcd/sim/scene.hpp"
 
 namespace clothcd {
@@ -31,39 +32,44 @@ void expect_input_error(F&& f, const std::vector<std::string>& parts) {
   }
 }
 
-// Found by fuzz_sim_obj: std::from_chars reads "nan"/"inf", so they reached the solver.
-TEST(SimObjReader, RejectsNonFiniteCoordinates) {
+// Found by fuzz_sim_obj, when the simulator had its own OBJ reader: std::from_chars reads
+// "nan"/"inf", so they reached the solver.
+TEST(SimObjInput, RejectsNonFiniteCoordinates) {
   CliScratch dir;
   for (const char* bad : {"nan", "inf", "-inf", "NaN"}) {
     const auto p =
         dir.write("c.obj", std::string("v 0 0 0\nv 1 ") + bad + " 0\nv 0 1 0\nf 1 2 3\n");
-    expect_input_error([&] { (void)sim::read_obj(p); }, {"c.obj:2:", "not finite"});
-    expect_input_error([&] { (void)sim::read_obj_positions(p); }, {"c.obj:2:", "not finite"});
+    expect_input_error([&] { (void)read_obj_with_stitches(p); }, {"c.obj:2:", "not finite"});
+    expect_input_error([&] { (void)read_obj_vertices(p); }, {"c.obj:2:", "not finite"});
   }
   const auto p = dir.write("t.obj", "v 0 0 0\nvt nan 0\n");
-  expect_input_error([&] { (void)sim::read_obj(p); }, {"t.obj:2:", "not finite"});
+  expect_input_error([&] { (void)read_obj_with_stitches(p); }, {"t.obj:2:", "not finite"});
   const auto s = dir.write("s.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nstitch 0 1 2 inf\n");
-  expect_input_error([&] { (void)sim::read_obj(s); }, {"s.obj:4:", "not finite"});
+  expect_input_error([&] { (void)read_obj_with_stitches(s); }, {"s.obj:4:", "stitch weight"});
 }
 
-// A stitch index of 2^32 + 1 used to be narrowed to vertex 1 and accepted.
-TEST(SimObjReader, RejectsStitchIndexPastInt) {
+// A stitch index of 2^32 + 1 was once narrowed to vertex 1 and accepted.
+TEST(SimObjInput, RejectsStitchIndexPastInt) {
   CliScratch dir;
   const auto p = dir.write("s.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nstitch 4294967297 0 2 0.5\n");
-  expect_input_error([&] { (void)sim::read_obj(p); }, {"s.obj:4:", "4294967297"});
+  expect_input_error([&] { (void)read_obj_with_stitches(p); }, {"s.obj:4:", "4294967297"});
   // Forward references stay allowed: the count is checked once the file is read.
   const auto q = dir.write("f.obj", "stitch 2 0 1 0.5\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-  EXPECT_EQ(sim::read_obj(q).stitches.size(), 1u);
+  EXPECT_EQ(read_obj_with_stitches(q).stitches.size(), 1u);
 }
 
-TEST(SimObjReader, RejectsIndicesOutOfRangeAndShortFaces) {
+TEST(SimObjInput, RejectsIndicesOutOfRangeAndShortFaces) {
   CliScratch dir;
   auto p = dir.write("a.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
-  expect_input_error([&] { (void)sim::read_obj(p); }, {"a.obj:4:", "out of range"});
+  expect_input_error([&] { (void)read_obj_with_stitches(p); }, {"a.obj:4:", "out of range"});
   p = dir.write("b.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n");
-  expect_input_error([&] { (void)sim::read_obj(p); }, {"b.obj:3:", "fewer than 3"});
+  expect_input_error([&] { (void)read_obj_with_stitches(p); }, {"b.obj:3:", "2 corners"});
   p = dir.write("c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/9 2 3\n");
-  expect_input_error([&] { (void)sim::read_obj(p); }, {"c.obj:4:", "texture"});
+  expect_input_error([&] { (void)read_obj_with_stitches(p); },
+                     {"c.obj:4:", "texture index 9 is out of range"});
+  p = dir.write("d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/-2 2 3\n");
+  expect_input_error([&] { (void)read_obj_with_stitches(p); },
+                     {"d.obj:5:", "relative texture index -2"});
 }
 
 TEST(SceneInput, RejectsHugeGridResolutionWithoutOverflow) {

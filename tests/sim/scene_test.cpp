@@ -6,7 +6,7 @@
 #include <string>
 
 #include "clothcd/core/error.hpp"
-#include "clothcd/sim/obj_reader.hpp"
+#include "clothcd/mesh/io.hpp"
 #include "clothcd/sim/scene.hpp"
 #include "clothcd/sim/sewing.hpp"
 #include "support/data.hpp"
@@ -236,11 +236,11 @@ TEST(Scene, DataScenesLoad) {
   // Frame 0 of the motion is the drape's pose once the drape is lifted by 0.75 m.
   std::vector<Vec3> b0;
   s.body->positions_at(0.0, b0);
-  const ObjData drape =
-      read_obj(body.parent_path().parent_path().parent_path() / "garments/dress_knife/drape.obj");
+  const TriangleMesh drape = clothcd::read_obj(body.parent_path().parent_path().parent_path() /
+                                               "garments/dress_knife/drape.obj");
   double worst = 0.0;
   for (int i = 0; i < 12811; ++i) {
-    worst = std::max(worst, (drape.positions[15656 + i] + Vec3(0, 0.75, 0) - b0[i]).norm());
+    worst = std::max(worst, (drape.vertices[15656 + i] + Vec3(0, 0.75, 0) - b0[i]).norm());
   }
   EXPECT_LT(worst, 1e-3);
 }
@@ -257,32 +257,6 @@ TEST(Sewing, RecoversTiesBetweenPanels) {
   EXPECT_EQ(ties[2].a, 4);
   EXPECT_EQ(ties[3].a, 7);
   EXPECT_TRUE(recover_stitches(x, f, 1e-4).empty());
-}
-
-TEST(ObjReader, ReadsFacesTexcoordsStitchesAndReportsLines) {
-  const auto dir = std::filesystem::temp_directory_path() / "clothcd_sim_obj_test";
-  std::filesystem::create_directories(dir);
-  {
-    std::ofstream o(dir / "a.obj");
-    o << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
-         "f 1/1 2/2 3/3 4/4\nstitch 0 1 2 0.5\n";
-  }
-  const ObjData d = read_obj(dir / "a.obj");
-  EXPECT_EQ(d.faces.size(), 2u);
-  EXPECT_EQ(d.face_texcoords[1][2], 3);
-  ASSERT_EQ(d.stitches.size(), 1u);
-  EXPECT_EQ(d.stitches[0].r, 0.5);
-  {
-    std::ofstream o(dir / "b.obj");
-    o << "v 0 0 0\nv 1 0 0\nf 1 2 7\n";
-  }
-  try {
-    (void)read_obj(dir / "b.obj");
-    FAIL() << "expected an InputError";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("b.obj:3"), std::string::npos) << e.what();
-  }
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -21,15 +21,22 @@ struct Stitch {
   friend bool operator==(const Stitch&, const Stitch&) = default;
 };
 
-/// An OBJ file's triangles (polygons fan-triangulated from their first corner, corner order kept)
-/// and its `stitch` lines. Texture coordinates, normals, groups and materials are ignored.
+/// An OBJ file's triangles (polygons fan-triangulated from their first corner, corner order kept),
+/// its `stitch` lines and its texture coordinates (a garment's flat pattern). Normals, groups and
+/// materials are ignored.
 struct ObjContents {
   TriangleMesh mesh;
   std::vector<Stitch> stitches;
+  std::vector<Eigen::Vector2d> texcoords;  ///< the `vt` lines (u v)
+  /// Per face (as in mesh.faces), each corner's texture coordinate index, -1 where it names none.
+  std::vector<Face> face_texcoords;
 };
 
 [[nodiscard]] ObjContents read_obj_with_stitches(const std::filesystem::path& path);
 [[nodiscard]] TriangleMesh read_obj(const std::filesystem::path& path);
+/// Only the `v` lines, checked as read_obj checks them; faces and other lines are skipped (the
+/// later frames of an animation whose faces the first frame gave).
+[[nodiscard]] std::vector<Eigen::Vector3d> read_obj_vertices(const std::filesystem::path& path);
 /// PLY: ascii, binary_little_endian or binary_big_endian; see docs/formats.md.
 [[nodiscard]] TriangleMesh read_ply(const std::filesystem::path& path);
 /// Dispatches on the extension (.obj or .ply, any case).
