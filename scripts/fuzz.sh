@@ -33,7 +33,10 @@ fi
 
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  mapfile -t targets < <(cd "$build/fuzz" && ls fuzz_* | grep -v '\.' | sort)
+  # The targets fuzz/CMakeLists.txt declares, not whatever binaries the build folder holds (a
+  # target removed from the source would otherwise still run from an old build).
+  mapfile -t targets < <(grep -o 'clothcd_add_fuzzer(fuzz_[a-z_0-9]*' fuzz/CMakeLists.txt |
+    sed 's/clothcd_add_fuzzer(//' | sort)
 fi
 mkdir -p "$build/fuzz-crashes" "$build/fuzz-logs"
 fuzz_one() {
