@@ -427,9 +427,10 @@ struct SelfDetector::Impl {
   }
 
   // Whether proximity(v0, h) can use the kept pairs: then the active restriction is set to the
-  // vertices that moved since (few, or the traversal is cheaper).
+  // vertices that moved since (few, or the traversal is cheaper). `reuse.valid` implies keeps():
+  // only detect() sets it, and set_options() clears it.
   bool reusable(double h) {
-    if (!reuse.valid || restricted || h > opt.reuse_distance || !keeps()) return false;
+    if (!reuse.valid || restricted || h > opt.reuse_distance) return false;
     const int nv = topo.num_vertices();
     std::vector<int> moved;
     for (int i = 0; i < nv; ++i) {

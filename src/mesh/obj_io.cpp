@@ -105,7 +105,7 @@ class ObjParser {
   void parse_line(std::string_view line) {
     if (vertices_only_) {
       // Only `v` lines count: skip the others before scanning them (an animation frame is
-      // mostly faces).
+      // mostly faces). What passes here is a `v` line.
       const std::size_t first = line.find_first_not_of(" \t");
       if (first == std::string_view::npos || line[first] != 'v' || first + 1 >= line.size() ||
           (line[first + 1] != ' ' && line[first + 1] != '\t')) {
@@ -123,8 +123,6 @@ class ObjParser {
     const std::string_view key = tokens_.items[0];
     if (key == "v") {
       parse_vertex();
-    } else if (vertices_only_) {
-      return;
     } else if (key == "vt") {
       parse_texcoord();
     } else if (key == "f") {
