@@ -97,7 +97,8 @@ ClothState ClothSolver::initial_state() const {
   return s;
 }
 
-bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool allow_fail) {
+bool ClothSolver::try_step(ClothState& state, double h, double tolerance, StepStats& stats,
+                           bool allow_fail) {
   Impl& im = *impl_;
   const int n = model_.num_vertices();
   const double beta = model_.material().damping;
@@ -171,7 +172,7 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
   const CouplingTerms* ct = im.couplings.empty() ? nullptr : &im.couplings;
   Vecs rhs = im.b;
   if (ct != nullptr) ct->add_rhs(state.v, rhs);
-  const PcgOptions pcg{options_.pcg_max_iterations, options_.pcg_tolerance};
+  const PcgOptions pcg{options_.pcg_max_iterations, tolerance};
   const double c = h * (h + beta);
   PcgOptions first = pcg;
   if (!im.constraints.empty() || ct != nullptr)
@@ -245,17 +246,20 @@ bool ClothSolver::try_step(ClothState& state, double h, StepStats& stats, bool a
   return true;
 }
 
-void ClothSolver::substep(ClothState& state, double h, int depth, StepStats& stats) {
+void ClothSolver::substep(ClothState& state, double h, double tolerance, int depth,
+                          StepStats& stats) {
   const bool last_chance = depth >= options_.max_halvings;
-  if (try_step(state, h, stats, last_chance)) return;
+  if (try_step(state, h, tolerance, stats, last_chance)) return;
   ++stats.halvings;
-  substep(state, 0.5 * h, depth + 1, stats);
-  substep(state, 0.5 * h, depth + 1, stats);
+  substep(state, 0.5 * h, tolerance, depth + 1, stats);
+  substep(state, 0.5 * h, tolerance, depth + 1, stats);
 }
 
-StepStats ClothSolver::step(ClothState& state, double h) {
+StepStats ClothSolver::step(ClothState& state, double h, bool fast) {
   StepStats stats;
-  substep(state, h, 0, stats);
+  stats.pcg_tolerance = fast && options_.fast_pcg_tolerance > 0.0 ? options_.fast_pcg_tolerance
+                                                                  : options_.pcg_tolerance;
+  substep(state, h, stats.pcg_tolerance, 0, stats);
   return stats;
 }
 

@@ -329,6 +329,8 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     s.solver.pcg_tolerance = o.number("pcg_tolerance", s.solver.pcg_tolerance, 0.0, 1.0);
     s.solver.release_tolerance =
         o.number("release_tolerance", s.solver.release_tolerance, 0.0, 1.0);
+    s.solver.fast_pcg_tolerance =
+        o.number("fast_pcg_tolerance", s.solver.fast_pcg_tolerance, 0.0, 1.0);
     s.solver.coarse_aggregate = o.integer("coarse_aggregate", s.solver.coarse_aggregate, 0);
     if (s.solver.coarse_aggregate == 1) {
       o.fail(o.key("coarse_aggregate"), "expected 0 (off) or at least 2, got 1");

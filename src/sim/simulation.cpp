@@ -62,9 +62,11 @@ FrameStats Simulation::advance_frame() {
   const double speed = scene_.substeps.cloth_speed(state_.v);
   fs.substeps = scene_.substeps.count(fs.body_displacement, speed * scene_.frame_dt);
   const double h = scene_.frame_dt / fs.substeps;
+  const bool fast = fs.substeps > scene_.substeps.min;
   for (int k = 0; k < fs.substeps; ++k) {
     state_.time = t0 + k * h;  // no drift: substep starts are exact multiples
-    const StepStats st = solver_->step(state_, h);
+    const StepStats st = solver_->step(state_, h, fast);
+    fs.pcg_tolerance = st.pcg_tolerance;
     fs.solves += st.solves;
     fs.pcg_iterations += st.pcg_iterations;
     fs.max_pcg_iterations = std::max(fs.max_pcg_iterations, st.max_pcg_iterations);

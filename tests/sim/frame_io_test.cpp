@@ -142,6 +142,7 @@ TEST(FrameIo, ResumeMatchesStraightRunBitwise) {
   EXPECT_EQ(manifest["solver"]["halve_unresolved"], scene.solver.halve_unresolved);
   EXPECT_EQ(manifest["solver"]["pcg_tolerance"], scene.solver.pcg_tolerance);
   EXPECT_EQ(manifest["solver"]["release_tolerance"], scene.solver.release_tolerance);
+  EXPECT_EQ(manifest["solver"]["fast_pcg_tolerance"], scene.solver.fast_pcg_tolerance);
   EXPECT_EQ(manifest["solver"]["coarse_aggregate"], scene.solver.coarse_aggregate);
   // Resuming a finished run does nothing.
   Simulation sim(test_scene());

@@ -109,6 +109,36 @@ TEST(Integrator, GravityChangesMomentumByMgh) {
   }
 }
 
+TEST(Integrator, FastStepsSolveToTheFastToleranceWhenOneIsSet) {
+  const ClothModel m(grid_cloth(10, 10, 0.4, 0.4), ClothMaterial{});
+  SolverOptions opt;
+  opt.pcg_tolerance = 1e-8;
+  opt.fast_pcg_tolerance = 1e-3;
+  opt.pcg_max_iterations = 5000;
+  ClothSolver solver(m, opt);
+  ClothState start = solver.initial_state();
+  std::mt19937_64 rng(7);
+  for (auto& v : start.v)
+    v = random_vec(rng, 0.5);
+  ClothState plain = start, fast = start;
+  const StepStats sp = solver.step(plain, 0.01);
+  const StepStats sf = solver.step(fast, 0.01, true);
+  EXPECT_EQ(sp.pcg_tolerance, 1e-8);
+  EXPECT_EQ(sf.pcg_tolerance, 1e-3);
+  EXPECT_LT(sf.pcg_iterations, sp.pcg_iterations);
+  EXPECT_NE(plain.x, fast.x);
+  // Unset, a fast step is the plain one, bit for bit.
+  opt.fast_pcg_tolerance = 0.0;
+  ClothSolver unset(m, opt);
+  ClothState a = start, b = start;
+  (void)unset.step(a, 0.01);
+  const StepStats sb = unset.step(b, 0.01, true);
+  EXPECT_EQ(sb.pcg_tolerance, 1e-8);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.v, b.v);
+  EXPECT_EQ(plain.x, a.x);
+}
+
 ClothState hang(ClothSolver& solver, const ClothModel& m, int nx, int steps,
                 std::vector<double>* kinetic = nullptr, double* stretch = nullptr) {
   ClothState s = solver.initial_state();

@@ -9,6 +9,7 @@
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/sim/scene.hpp"
 #include "clothcd/sim/sewing.hpp"
+#include "clothcd/sim/simulation.hpp"
 #include "support/data.hpp"
 
 namespace clothcd::sim {
@@ -65,6 +66,31 @@ TEST(Scene, FirstSolveStopsAtTheReleaseToleranceTheSceneGives) {
   EXPECT_EQ(parse_scene(j, "test-scene.json").solver.release_tolerance, 1e-3);
   j["solver"] = {{"release_tolerance", 2.0}};
   EXPECT_THROW((void)parse_scene(j, "test-scene.json"), InputError);
+}
+
+TEST(Scene, FastFramesKeepThePcgToleranceUnlessTheSceneGivesOne) {
+  json j = small_grid_scene();
+  EXPECT_EQ(parse_scene(j, "test-scene.json").solver.fast_pcg_tolerance, 0.0);
+  j["solver"] = {{"fast_pcg_tolerance", 3e-3}};
+  EXPECT_EQ(parse_scene(j, "test-scene.json").solver.fast_pcg_tolerance, 3e-3);
+  j["solver"] = {{"fast_pcg_tolerance", -1e-3}};
+  EXPECT_NE(error_of(j).find("fast_pcg_tolerance"), std::string::npos) << error_of(j);
+}
+
+// The first frame starts at rest (the floor of substeps), the second falling (the cloth rule asks
+// for more): only the second is a fast frame.
+TEST(Scene, OnlyFramesAboveTheSubstepFloorUseTheFastTolerance) {
+  json j = small_grid_scene();
+  j.erase("pins");
+  j["substeps"] = {{"min", 2}, {"max", 8}, {"cloth_displacement", 1e-3}};
+  j["solver"] = {{"pcg_tolerance", 1e-6}, {"fast_pcg_tolerance", 1e-3}};
+  Simulation sim(parse_scene(j, "test-scene.json"));
+  const FrameStats first = sim.advance_frame();
+  const FrameStats second = sim.advance_frame();
+  EXPECT_EQ(first.substeps, 2);
+  EXPECT_EQ(first.pcg_tolerance, 1e-6);
+  EXPECT_GT(second.substeps, 2);
+  EXPECT_EQ(second.pcg_tolerance, 1e-3);
 }
 
 TEST(Scene, CoarseCorrectionIsOffUnlessTheSceneGivesAnAggregateSize) {

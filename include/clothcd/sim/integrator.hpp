@@ -42,6 +42,11 @@ struct SolverOptions {
   /// 1e-2 they took 18 and 64 (docs/simulator.md, "Measured"). At or below pcg_tolerance: the
   /// complete first solve, redone only when something was let go (as before session 14).
   double release_tolerance = 1e-2;
+  /// The PCG tolerance of the substeps of a fast frame (ClothSolver::step's `fast`): one that
+  /// the substep rule gave more than its minimum of substeps, so that each substep moves the body
+  /// or the cloth as far as the rule allows and the time step's own error outweighs the solve's
+  /// (docs/simulator.md, "Measured", session 19). 0: pcg_tolerance in every frame.
+  double fast_pcg_tolerance = 0.0;
   /// Vertices per aggregate of the PCG's coarse correction (a two-level preconditioner: block
   /// Jacobi plus one translation per aggregate, factored every substep); 0: block Jacobi alone.
   int coarse_aggregate = 0;
@@ -59,8 +64,9 @@ struct StepStats {
   int pcg_iterations = 0;  ///< summed over solves
   int max_pcg_iterations = 0;
   int halvings = 0;
-  bool converged = true;     ///< every solve reached pcg_tolerance
-  double max_stretch = 0.0;  ///< largest membrane stretch at the substeps' start states
+  bool converged = true;       ///< every solve reached its tolerance
+  double pcg_tolerance = 0.0;  ///< the tolerance the solves aimed at
+  double max_stretch = 0.0;    ///< largest membrane stretch at the substeps' start states
   CollisionStats collision;
 };
 
@@ -87,8 +93,9 @@ class ClothSolver {
 
   /// The state at rest: initial positions, zero velocity, t = 0.
   [[nodiscard]] ClothState initial_state() const;
-  /// Advances `state` by h (halving on failure as SolverOptions says).
-  StepStats step(ClothState& state, double h);
+  /// Advances `state` by h (halving on failure as SolverOptions says). `fast`: a substep of a
+  /// fast frame, solved to SolverOptions::fast_pcg_tolerance when that is set.
+  StepStats step(ClothState& state, double h, bool fast = false);
 
   /// Potential energy (elastic + gravity) at x.
   [[nodiscard]] double potential_energy(const std::vector<Vec3>& x) const;
@@ -101,8 +108,8 @@ class ClothSolver {
 
  private:
   struct Impl;
-  bool try_step(ClothState& state, double h, StepStats& stats, bool allow_fail);
-  void substep(ClothState& state, double h, int depth, StepStats& stats);
+  bool try_step(ClothState& state, double h, double tolerance, StepStats& stats, bool allow_fail);
+  void substep(ClothState& state, double h, double tolerance, int depth, StepStats& stats);
 
   const ClothModel& model_;
   SolverOptions options_;

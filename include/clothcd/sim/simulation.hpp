@@ -21,6 +21,9 @@ struct FrameStats {
   int max_pcg_iterations = 0;
   int halvings = 0;
   bool pcg_converged = true;
+  /// The PCG tolerance of the frame's solves: SolverOptions::fast_pcg_tolerance in a fast frame
+  /// (more substeps than SubstepRule::min), pcg_tolerance otherwise.
+  double pcg_tolerance = 0.0;
   double seconds = 0.0;
   double collision_seconds = 0.0;
   double max_stretch = 0.0;  ///< at the end of the frame
