@@ -338,6 +338,16 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     s.solver.halve_residual = o.number("halve_residual", s.solver.halve_residual, 0.0, INFINITY);
     s.solver.max_halvings = o.integer("max_halvings", s.solver.max_halvings, 0, 10);
     s.solver.halve_unresolved = o.boolean("halve_unresolved", s.solver.halve_unresolved);
+    // A solve that may stop above halve_residual would have every substep halved.
+    for (const auto& [k, tolerance] :
+         {std::pair{"pcg_tolerance", s.solver.pcg_tolerance},
+          std::pair{"fast_pcg_tolerance", s.solver.fast_pcg_tolerance}}) {
+      if (s.solver.max_halvings > 0 && tolerance > s.solver.halve_residual) {
+        o.fail(o.key(k), fmt::format("{} is above halve_residual ({}): every substep would be "
+                                     "halved (raise halve_residual or set max_halvings 0)",
+                                     tolerance, s.solver.halve_residual));
+      }
+    }
     o.finish();
   }
   if (top.has("substeps")) {

@@ -77,6 +77,25 @@ TEST(Scene, FastFramesKeepThePcgToleranceUnlessTheSceneGivesOne) {
   EXPECT_NE(error_of(j).find("fast_pcg_tolerance"), std::string::npos) << error_of(j);
 }
 
+// A tolerance above halve_residual would halve every substep it solves: an error, unless halving
+// is off or halve_residual is raised with it.
+TEST(Scene, ToleranceAboveTheHalvingResidualIsAnError) {
+  json j = small_grid_scene();
+  for (const char* key : {"pcg_tolerance", "fast_pcg_tolerance"}) {
+    j["solver"] = {{key, 0.05}};
+    const std::string e = error_of(j);
+    EXPECT_NE(e.find(std::string("solver.") + key + "': 0.05 is above halve_residual (0.01)"),
+              std::string::npos)
+        << e;
+    j["solver"] = {{key, 0.05}, {"max_halvings", 0}};
+    EXPECT_EQ(error_of(j), "");
+    j["solver"] = {{key, 0.05}, {"halve_residual", 0.05}};
+    EXPECT_EQ(error_of(j), "");
+  }
+  j["solver"] = {{"fast_pcg_tolerance", 0.01}};
+  EXPECT_EQ(error_of(j), "");
+}
+
 // The first frame starts at rest (the floor of substeps), the second falling (the cloth rule asks
 // for more): only the second is a fast frame.
 TEST(Scene, OnlyFramesAboveTheSubstepFloorUseTheFastTolerance) {
