@@ -176,4 +176,14 @@ void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options)
   });
 }
 
+double Bvh::box_area_ratio() const {
+  double internal = 0.0, leaves = 0.0;
+  for (const BvhNode& n : nodes_) {
+    const double dx = n.hi[0] - n.lo[0], dy = n.hi[1] - n.lo[1], dz = n.hi[2] - n.lo[2];
+    (n.is_leaf() ? leaves : internal) += dx * dy + dy * dz + dz * dx;
+  }
+  if (leaves > 0.0) return internal / leaves;
+  return internal > 0.0 ? std::numeric_limits<double>::infinity() : 1.0;
+}
+
 }  // namespace clothcd

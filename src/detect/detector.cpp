@@ -511,6 +511,13 @@ void SelfDetector::set_active_vertices(std::span<const int> vertices) {
 void SelfDetector::clear_active_faces() {
   impl_->restricted = false;
 }
+void SelfDetector::rebuild(const Positions& reference) {
+  Impl& im = *impl_;
+  std::vector<Eigen::Vector3d> ref;
+  detail::to_points(reference, im.topo.num_vertices(), "reference shape", ref);
+  im.bvh = Bvh(im.topo, ref, im.opt.build);
+  im.restricted = false;  // its node flags belonged to the old tree
+}
 const DetectOptions& SelfDetector::options() const {
   return impl_->opt;
 }

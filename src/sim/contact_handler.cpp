@@ -18,6 +18,7 @@
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/sim/intersections.hpp"
+#include "fitted_tree.hpp"
 #include "seam_links.hpp"
 #include "zone_motion.hpp"
 
@@ -104,9 +105,14 @@ struct ContactHandler::Impl {
   ContactOptions opt;
   detail::SeamLinks links;
   std::optional<SelfDetector> self;
-  // Body: proximity and CCD through clothcd BVHs of both meshes (static, then swept boxes).
+  // The self detector's box area ratio after the first full pass since its tree was built (0:
+  // not yet seen), and whether the next substep rebuilds that tree (see note_self_fit()).
+  double self_fit = 0.0;
+  bool self_rebuild = false;
+  // Body: proximity and CCD through clothcd BVHs of both meshes (static, then swept boxes),
+  // rebuilt when the meshes have deformed far from their build shapes.
   std::optional<Topology> body_topo;
-  Bvh cloth_bvh, body_bvh;
+  detail::FittedTree cloth_tree, body_tree;
   std::vector<Contact> proximity;
   std::vector<ContactConstraint> constraints;  // see add_constraint()
   std::vector<ContactCoupling> couplings;      // see add_proximity()
@@ -429,8 +435,8 @@ struct ContactHandler::Impl {
     body_topo.emplace(*ctx.body_faces, nb);
     detail::designated_faces(model.topology(), cloth_vertex_face, cloth_edge_face);
     detail::designated_faces(*body_topo, body_vertex_face, body_edge_face);
-    cloth_bvh = Bvh(model.topology(), ctx.x0, BvhBuild::Spatial);
-    body_bvh = Bvh(*body_topo, ctx.body_t0, BvhBuild::Spatial);
+    cloth_tree = detail::FittedTree(model.topology());  // built at the first refit
+    body_tree = detail::FittedTree(*body_topo);
   }
 
   [[nodiscard]] bool has_body(const SubstepContext& ctx) const {
@@ -454,7 +460,7 @@ struct ContactHandler::Impl {
         vertex_use[i] = 1;
       face_flag = t.faces_touching(vertex_use);
       edge_use = t.edges_touching(vertex_use);
-      node_flag = cloth_bvh.nodes_holding(face_flag);
+      node_flag = cloth_tree.bvh().nodes_holding(face_flag);
     }
     if (escapes.empty()) return;
     if (vertex_use.empty()) vertex_use.assign(t.num_vertices(), 1);
@@ -471,11 +477,25 @@ struct ContactHandler::Impl {
   }
 
   [[nodiscard]] detail::PairSide cloth_side() const {
-    return {&model.topology(), &cloth_bvh, &cloth_boxes, cloth_vertex_face,
-            cloth_edge_face,   vertex_use, edge_use,     face_use};
+    return {&model.topology(), &cloth_tree.bvh(), &cloth_boxes, cloth_vertex_face,
+            cloth_edge_face,   vertex_use,        edge_use,     face_use};
   }
   [[nodiscard]] detail::PairSide body_side() const {
-    return {&*body_topo, &body_bvh, &body_boxes, body_vertex_face, body_edge_face, {}, {}, {}};
+    return {&*body_topo, &body_tree.bvh(), &body_boxes, body_vertex_face, body_edge_face, {}, {},
+            {}};
+  }
+
+  // The detector's tree keeps the splits of the shape it was built on; when its boxes, in the
+  // substeps' full passes, have loosened past FittedTree::kLooser times their fit in the first
+  // pass after the build, the next substep rebuilds it on its start (the same pairs, faster:
+  // multilayer-kick frame 90, the first pass took 96 ms on the frame-0 tree, 58 ms rebuilt).
+  void note_self_fit() {
+    const double ratio = self->bvh().box_area_ratio();
+    if (self_fit == 0.0) {
+      self_fit = ratio;
+    } else if (ratio > detail::FittedTree::kLooser * self_fit) {
+      self_rebuild = true;
+    }
   }
 
   void prepare(const SubstepContext& ctx) {
@@ -507,6 +527,10 @@ struct ContactHandler::Impl {
         // Seam-linked vertices count as one point: the seam's sides touch by design.
         o.linked_vertices = model.seam_links();
         self.emplace(model.topology().faces(), model.num_vertices(), x0m, o);
+      } else if (self_rebuild) {
+        self->rebuild(x0m);
+        self_fit = 0.0;
+        self_rebuild = false;
       }
       const ProximityResult r = self->proximity(x0m, dh);
       for (const auto& p : r.vf) {
@@ -524,8 +548,8 @@ struct ContactHandler::Impl {
       RefitOptions ro;
       ro.cones = false;
       ro.thickness = dh;
-      cloth_bvh.refit(x0, ro);
-      body_bvh.refit(b0, ro);
+      cloth_tree.refit(x0, ro);
+      body_tree.refit(b0, ro);
       const auto& cf = model.topology().faces();
       const auto& bf = body_topo->faces();
       const auto& ce = model.topology().edges();
@@ -697,6 +721,7 @@ struct ContactHandler::Impl {
         self->clear_active_faces();
       }
       const DetectResult r = self->detect(x0m, x1m);
+      if (active == nullptr) note_self_fit();
       // Each hit in parallel; the contacts are then gathered in the detector's sorted order.
       const auto& faces = model.topology().faces();
       const auto& edges = model.topology().edges();
@@ -746,10 +771,11 @@ struct ContactHandler::Impl {
     RefitOptions ro;
     ro.cones = false;
     ro.thickness = sep;
-    cloth_bvh.refit_changed(x0, x1, ro);  // a later pass redoes the nodes over moved vertices
+    cloth_tree.bvh().refit_changed(x0, x1,
+                                   ro);   // a later pass redoes the nodes over moved vertices
     const bool refit_body = !body_swept;  // the body's motion is fixed for the substep
     if (refit_body) {
-      body_bvh.refit(b0, b1, ro);
+      body_tree.bvh().refit(b0, b1, ro);
       body_swept = true;
     }
     set_scope(active);

@@ -6,6 +6,7 @@
 
 #include "bvh_pairs.hpp"
 #include "clothcd/bvh/bvh.hpp"
+#include "fitted_tree.hpp"
 #include "seam_links.hpp"
 
 namespace clothcd::sim {
@@ -58,13 +59,15 @@ struct IntersectionCounter::Impl {
   const Topology& cloth;
   detail::SeamLinks links;
   std::optional<Topology> body;
-  Bvh cloth_bvh, body_bvh;
-  bool cloth_built = false, body_built = false;
+  detail::FittedTree cloth_tree, body_tree;
 
   Impl(const Topology& c, std::span<const std::pair<int, int>> st, const std::vector<Face>& bf,
        int nb)
-      : cloth(c), links(c.num_vertices(), st) {
-    if (!bf.empty()) body.emplace(bf, nb);
+      : cloth(c), links(c.num_vertices(), st), cloth_tree(c) {
+    if (!bf.empty()) {
+      body.emplace(bf, nb);
+      body_tree = detail::FittedTree(*body);
+    }
   }
 
   [[nodiscard]] bool skip_self(int f, int g) const {
@@ -86,19 +89,17 @@ IntersectionCounter::~IntersectionCounter() = default;
 
 std::vector<std::pair<int, int>> IntersectionCounter::self_pairs(std::span<const Vec3> x) {
   Impl& im = *impl_;
-  if (!im.cloth_built) {
-    im.cloth_bvh = Bvh(im.cloth, x, BvhBuild::Spatial);
-    im.cloth_built = true;
-  }
   RefitOptions ro;
   ro.cones = false;
-  im.cloth_bvh.refit(x, ro);
+  im.cloth_tree.refit(x, ro);
   const auto& faces = im.cloth.faces();
   tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>> found;
-  detail::for_each_self_overlap_parallel(im.cloth_bvh, found, [&](int f, int g, auto& local) {
-    if (im.skip_self(f, g)) return;
-    if (Impl::test(x, faces[f], x, faces[g])) local.emplace_back(std::min(f, g), std::max(f, g));
-  });
+  detail::for_each_self_overlap_parallel(im.cloth_tree.bvh(), found,
+                                         [&](int f, int g, auto& local) {
+                                           if (im.skip_self(f, g)) return;
+                                           if (Impl::test(x, faces[f], x, faces[g]))
+                                             local.emplace_back(std::min(f, g), std::max(f, g));
+                                         });
   return merged(found);
 }
 
@@ -107,22 +108,14 @@ std::vector<std::pair<int, int>> IntersectionCounter::body_pairs(std::span<const
   Impl& im = *impl_;
   std::vector<std::pair<int, int>> out;
   if (!im.body) return out;
-  if (!im.cloth_built) {
-    im.cloth_bvh = Bvh(im.cloth, x, BvhBuild::Spatial);
-    im.cloth_built = true;
-  }
-  if (!im.body_built) {
-    im.body_bvh = Bvh(*im.body, body, BvhBuild::Spatial);
-    im.body_built = true;
-  }
   RefitOptions ro;
   ro.cones = false;
-  im.cloth_bvh.refit(x, ro);
-  im.body_bvh.refit(body, ro);
+  im.cloth_tree.refit(x, ro);
+  im.body_tree.refit(body, ro);
   const auto& cf = im.cloth.faces();
   const auto& bf = im.body->faces();
   tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>> found;
-  detail::for_each_overlap_parallel(im.cloth_bvh, im.body_bvh, found,
+  detail::for_each_overlap_parallel(im.cloth_tree.bvh(), im.body_tree.bvh(), found,
                                     [&](int f, int g, auto& local) {
                                       if (Impl::test(x, cf[f], body, bf[g]))
                                         local.emplace_back(f, g);

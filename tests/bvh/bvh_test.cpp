@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <numeric>
 #include <set>
 
@@ -124,6 +125,84 @@ TEST(Bvh, RefitChangedEqualsFullRefitAfterEveryCall) {
       }
     }
   }
+}
+
+// A boxes-only build: the full build's nodes, permutation and boxes, without flags or contours.
+TEST(Bvh, BoxesOnlyIsTheSameTreeWithoutFlags) {
+  for (const auto& s : {stacked_sheets(6), crumpled_sheet(8, 7), twisted_strip(30, 3)}) {
+    const Topology topo(s.faces, s.num_vertices);
+    const auto v0 = points(s.v_t0), v1 = points(s.v_t1);
+    for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+      SCOPED_TRACE(::testing::Message() << s.name << " build " << int(build));
+      Bvh full(topo, v0, build);
+      Bvh boxes = Bvh::boxes_only(topo, v0, build);
+      RefitOptions ro;
+      ro.cones = false;
+      full.refit(v0, v1, ro);
+      boxes.refit(v0, v1, ro);
+      EXPECT_EQ(boxes.prim_ids(), full.prim_ids());
+      EXPECT_EQ(boxes.level_offsets(), full.level_offsets());
+      ASSERT_EQ(boxes.nodes().size(), full.nodes().size());
+      EXPECT_GT(full.num_connected_internal(), 0);
+      for (std::size_t i = 0; i < full.nodes().size(); ++i) {
+        const BvhNode &a = boxes.nodes()[i], &b = full.nodes()[i];
+        EXPECT_EQ(a.lo, b.lo);
+        EXPECT_EQ(a.hi, b.hi);
+        EXPECT_EQ(a.left, b.left);
+        EXPECT_EQ(a.first, b.first);
+        EXPECT_EQ(a.count, b.count);
+        EXPECT_EQ(a.flags, 0u);
+        EXPECT_TRUE(boxes.contour(static_cast<int>(i)).empty());
+        EXPECT_EQ(boxes.leaf_of_face(boxes.prim_ids()[a.first]) == static_cast<int>(i),
+                  a.is_leaf());
+      }
+    }
+  }
+}
+
+// The box area ratio: internal over leaf box areas by hand on a two-triangle tree, and its growth
+// when a tree built on a folded sheet is refit to the sheet unfolded, against a tree built there.
+TEST(Bvh, BoxAreaRatioGrowsAsARefitTreeLoosens) {
+  const std::vector<Face> two{{0, 1, 2}, {1, 3, 2}};
+  const Topology t2(two, 4);
+  const std::vector<Eigen::Vector3d> sq{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  Bvh small(t2, sq, BvhBuild::Spatial);
+  RefitOptions ro;
+  ro.cones = false;
+  small.refit(sq, ro);
+  EXPECT_DOUBLE_EQ(small.box_area_ratio(), 0.5);  // root 1 x 1, each leaf 1 x 1
+  const std::vector<Eigen::Vector3d> point(4, Eigen::Vector3d(1, 2, 3));
+  small.refit(point, ro);
+  EXPECT_EQ(small.box_area_ratio(), 1.0);
+
+  // A 24 x 24 grid on the unit square, and the same folded in half (its two halves 2 mm
+  // apart): the tree built folded puts faces of both halves in one node, which the unfolding
+  // then stretches across the sheet.
+  const int n = 24;
+  std::vector<Face> faces;
+  std::vector<Eigen::Vector3d> flat, folded;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      const double x = double(i) / n, y = double(j) / n;
+      flat.emplace_back(x, y, 0.0);
+      folded.emplace_back(x <= 0.5 ? x : 1.0 - x, y, x <= 0.5 ? 0.0 : 2e-3);
+    }
+  }
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i;
+      faces.push_back({a, a + 1, a + n + 2});
+      faces.push_back({a, a + n + 2, a + n + 1});
+    }
+  }
+  const Topology topo(faces, static_cast<int>(flat.size()));
+  Bvh old_tree(topo, folded, BvhBuild::Spatial), new_tree(topo, flat, BvhBuild::Spatial);
+  old_tree.refit(folded, ro);
+  const double built = old_tree.box_area_ratio();
+  old_tree.refit(flat, ro);
+  new_tree.refit(flat, ro);
+  EXPECT_GT(old_tree.box_area_ratio(), 3.0 * built);
+  EXPECT_GT(old_tree.box_area_ratio(), 1.5 * new_tree.box_area_ratio());
 }
 
 }  // namespace

@@ -192,6 +192,55 @@ TEST(DetectApi, ReusedDetectorEqualsBruteForceOverASequenceOfCalls) {
   }
 }
 
+// rebuild(): the tree a build on the new shape gives, the same pairs as brute force before and
+// after (CCD, and a proximity query that reuses the last detection's pairs), the restriction
+// cleared, and a reference of the wrong size an InputError.
+TEST(DetectApi, RebuiltDetectorEqualsBruteForce) {
+  for (const auto& s : {crumpled_sheet(8, 3), twisted_strip(30, 3), stacked_sheets(6)}) {
+    const Topology topo(s.faces, s.num_vertices);
+    const Positions mid = 0.5 * (s.v_t0 + s.v_t1);
+    const DetectResult ref0 = brute_force_detect(topo, s.v_t0, mid);
+    const DetectResult ref1 = brute_force_detect(topo, mid, s.v_t1);
+    const ProximityResult near = brute_force_proximity(topo, s.v_t1, 0.01);
+    EXPECT_GT(ref1.vf.size() + ref1.ee.size(), 0u);
+    for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+      for (Culling culling : {Culling::None, Culling::Sound}) {
+        SCOPED_TRACE(::testing::Message()
+                     << s.name << " build " << int(build) << " culling " << int(culling));
+        DetectOptions o;
+        o.build = build;
+        o.culling = culling;
+        o.reuse_distance = 0.01;
+        SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+        DetectResult r = det.detect(s.v_t0, mid);
+        EXPECT_EQ(vf_pairs(r.vf), vf_pairs(ref0.vf));
+        EXPECT_EQ(ee_pairs(r.ee), ee_pairs(ref0.ee));
+        std::vector<int> few{0, 1, 2};
+        det.set_active_vertices(few);
+        det.rebuild(mid);
+        std::vector<Eigen::Vector3d> m(s.num_vertices);
+        for (int v = 0; v < s.num_vertices; ++v)
+          m[v] = mid.row(v).transpose();
+        const Bvh fresh(topo, m, build);
+        EXPECT_EQ(det.bvh().prim_ids(), fresh.prim_ids());
+        EXPECT_EQ(det.bvh().nodes().size(), fresh.nodes().size());
+        r = det.detect(mid, s.v_t1);  // unrestricted: every pair
+        EXPECT_EQ(vf_pairs(r.vf), vf_pairs(ref1.vf));
+        EXPECT_EQ(ee_pairs(r.ee), ee_pairs(ref1.ee));
+        det.rebuild(s.v_t1);
+        const ProximityResult p = det.proximity(s.v_t1, 0.01);
+        if (culling == Culling::None) {
+          EXPECT_GT(p.reused_pairs, 0u);  // the kept pairs survive the rebuild
+        }
+        EXPECT_EQ(vf_pairs(p.vf), vf_pairs(near.vf));
+        EXPECT_EQ(ee_pairs(p.ee), ee_pairs(near.ee));
+      }
+    }
+    SelfDetector det(s.faces, s.num_vertices, s.v_t0);
+    EXPECT_THROW(det.rebuild(s.v_t0.topRows(s.num_vertices - 1)), InputError);
+  }
+}
+
 // Every counter of a detection (times excluded).
 std::vector<std::uint64_t> counters(const DetectStats& s) {
   return {s.box_tests,

@@ -59,6 +59,13 @@ class SelfDetector {
   void set_active_vertices(std::span<const int> vertices);
   void clear_active_faces();
 
+  /// Builds the BVH afresh, split on `reference` (the same build kind). The tree is refit at
+  /// every call but keeps the splits of the shape it was built on; once the mesh has deformed
+  /// far from that shape its boxes are loose (Bvh::box_area_ratio() grows) and the traversals
+  /// slow down. Results do not change. Clears an active restriction; keeps the pairs kept for
+  /// reuse (DetectOptions::reuse_distance). Throws InputError for a reference of the wrong size.
+  void rebuild(const Positions& reference);
+
   [[nodiscard]] const DetectOptions& options() const;
   void set_options(const DetectOptions& options);  ///< the BVH build stays as constructed
   [[nodiscard]] const Topology& topology() const;
