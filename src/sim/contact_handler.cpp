@@ -771,8 +771,8 @@ struct ContactHandler::Impl {
     RefitOptions ro;
     ro.cones = false;
     ro.thickness = sep;
-    cloth_tree.bvh().refit_changed(x0, x1,
-                                   ro);   // a later pass redoes the nodes over moved vertices
+    // A later pass redoes only the nodes over moved vertices.
+    cloth_tree.bvh().refit_changed(x0, x1, ro);
     const bool refit_body = !body_swept;  // the body's motion is fixed for the substep
     if (refit_body) {
       body_tree.bvh().refit(b0, b1, ro);
