@@ -105,10 +105,12 @@ struct ContactHandler::Impl {
   ContactOptions opt;
   detail::SeamLinks links;
   std::optional<SelfDetector> self;
-  // The self detector's box area ratio after the first full pass since its tree was built (0:
-  // not yet seen), and whether the next substep rebuilds that tree (see note_self_fit()).
+  // The self detector's box area ratio after the first full CCD pass since its tree was built
+  // (0: not yet seen). The detector's tree keeps the splits of the shape it was built on; once
+  // its boxes have loosened past that (FittedTree::loosened), a substep rebuilds it on its start
+  // (the same pairs, faster: multilayer-kick frame 90, the first pass took 96 ms on the frame-0
+  // tree, 58 ms rebuilt).
   double self_fit = 0.0;
-  bool self_rebuild = false;
   // Body: proximity and CCD through clothcd BVHs of both meshes (static, then swept boxes),
   // rebuilt when the meshes have deformed far from their build shapes.
   std::optional<Topology> body_topo;
@@ -485,19 +487,6 @@ struct ContactHandler::Impl {
             {}};
   }
 
-  // The detector's tree keeps the splits of the shape it was built on; when its boxes, in the
-  // substeps' full passes, have loosened past FittedTree::kLooser times their fit in the first
-  // pass after the build, the next substep rebuilds it on its start (the same pairs, faster:
-  // multilayer-kick frame 90, the first pass took 96 ms on the frame-0 tree, 58 ms rebuilt).
-  void note_self_fit() {
-    const double ratio = self->bvh().box_area_ratio();
-    if (self_fit == 0.0) {
-      self_fit = ratio;
-    } else if (ratio > detail::FittedTree::kLooser * self_fit) {
-      self_rebuild = true;
-    }
-  }
-
   void prepare(const SubstepContext& ctx) {
     x0 = ctx.x0;
     b0 = ctx.body_t0;
@@ -527,10 +516,10 @@ struct ContactHandler::Impl {
         // Seam-linked vertices count as one point: the seam's sides touch by design.
         o.linked_vertices = model.seam_links();
         self.emplace(model.topology().faces(), model.num_vertices(), x0m, o);
-      } else if (self_rebuild) {
-        self->rebuild(x0m);
+      } else if (self_fit > 0.0 &&
+                 detail::FittedTree::loosened(self->bvh().box_area_ratio(), self_fit)) {
+        self->rebuild(x0m);  // its boxes are still the last CCD pass's
         self_fit = 0.0;
-        self_rebuild = false;
       }
       const ProximityResult r = self->proximity(x0m, dh);
       for (const auto& p : r.vf) {
@@ -721,7 +710,7 @@ struct ContactHandler::Impl {
         self->clear_active_faces();
       }
       const DetectResult r = self->detect(x0m, x1m);
-      if (active == nullptr) note_self_fit();
+      if (active == nullptr && self_fit == 0.0) self_fit = self->bvh().box_area_ratio();
       // Each hit in parallel; the contacts are then gathered in the detector's sorted order.
       const auto& faces = model.topology().faces();
       const auto& edges = model.topology().edges();

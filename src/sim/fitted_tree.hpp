@@ -17,6 +17,9 @@ class FittedTree {
  public:
   /// Rebuild past this growth of the box area ratio since the last build.
   static constexpr double kLooser = 1.5;
+  /// Whether a tree whose box area ratio was `fit` right after its build has loosened enough to
+  /// rebuild at `ratio` (never when either is NaN).
+  [[nodiscard]] static bool loosened(double ratio, double fit) { return ratio > kLooser * fit; }
 
   FittedTree() = default;
   /// The topology must outlive the tree. Nothing is built before the first refit.
@@ -27,7 +30,7 @@ class FittedTree {
   void refit(std::span<const Vec3> x, const RefitOptions& options) {
     if (builds_ > 0) {
       bvh_.refit(x, options);
-      if (!(bvh_.box_area_ratio() > kLooser * built_ratio_)) return;
+      if (!loosened(bvh_.box_area_ratio(), built_ratio_)) return;
     }
     bvh_ = Bvh::boxes_only(*topology_, x, BvhBuild::Spatial);
     bvh_.refit(x, options);

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <optional>
 #include <random>
+#include <tuple>
 
 #include "api_scenes.hpp"
 #include "clothcd/ccd/proximity.hpp"
@@ -196,6 +197,7 @@ TEST(DetectApi, ReusedDetectorEqualsBruteForceOverASequenceOfCalls) {
 // after (CCD, and a proximity query that reuses the last detection's pairs), the restriction
 // cleared, and a reference of the wrong size an InputError.
 TEST(DetectApi, RebuiltDetectorEqualsBruteForce) {
+  int changed = 0;  // cases in which the rebuilt tree differs from the original one
   for (const auto& s : {crumpled_sheet(8, 3), twisted_strip(30, 3), stacked_sheets(6)}) {
     const Topology topo(s.faces, s.num_vertices);
     const Positions mid = 0.5 * (s.v_t0 + s.v_t1);
@@ -218,12 +220,22 @@ TEST(DetectApi, RebuiltDetectorEqualsBruteForce) {
         std::vector<int> few{0, 1, 2};
         det.set_active_vertices(few);
         det.rebuild(mid);
-        std::vector<Eigen::Vector3d> m(s.num_vertices);
-        for (int v = 0; v < s.num_vertices; ++v)
+        // The tree a build on `mid` gives, node for node, flags included.
+        std::vector<Eigen::Vector3d> m(s.num_vertices), m0(s.num_vertices);
+        for (int v = 0; v < s.num_vertices; ++v) {
           m[v] = mid.row(v).transpose();
+          m0[v] = s.v_t0.row(v).transpose();
+        }
         const Bvh fresh(topo, m, build);
         EXPECT_EQ(det.bvh().prim_ids(), fresh.prim_ids());
-        EXPECT_EQ(det.bvh().nodes().size(), fresh.nodes().size());
+        ASSERT_EQ(det.bvh().nodes().size(), fresh.nodes().size());
+        for (std::size_t i = 0; i < fresh.nodes().size(); ++i) {
+          const BvhNode &a = det.bvh().nodes()[i], &b = fresh.nodes()[i];
+          EXPECT_EQ(std::tuple(a.left, a.first, a.count, a.flags),
+                    std::tuple(b.left, b.first, b.count, b.flags))
+              << "node " << i;
+        }
+        if (Bvh(topo, m0, build).prim_ids() != fresh.prim_ids()) ++changed;
         r = det.detect(mid, s.v_t1);  // unrestricted: every pair
         EXPECT_EQ(vf_pairs(r.vf), vf_pairs(ref1.vf));
         EXPECT_EQ(ee_pairs(r.ee), ee_pairs(ref1.ee));
@@ -239,6 +251,7 @@ TEST(DetectApi, RebuiltDetectorEqualsBruteForce) {
     SelfDetector det(s.faces, s.num_vertices, s.v_t0);
     EXPECT_THROW(det.rebuild(s.v_t0.topRows(s.num_vertices - 1)), InputError);
   }
+  EXPECT_GT(changed, 0);  // so the node comparison above shows a rebuild, not the old tree
 }
 
 // Every counter of a detection (times excluded).
