@@ -2,20 +2,30 @@
 // contains what it must contain.
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
-#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <vector>
 
 #include "clothcd/cone.hpp"
 #include "fuzz_input.hpp"
+#include "support/exact_normal.hpp"
 
 namespace {
 
 using clothcd::NormalCone;
 using Eigen::Vector3d;
+
+// x, y, z in that order (the order of a constructor's arguments is unspecified).
+Vector3d read_vector(clothcd::fuzz::ByteReader& in) {
+  const double x = in.finite_double();
+  const double y = in.finite_double();
+  const double z = in.finite_double();
+  return {x, y, z};
+}
 
 bool finite(const NormalCone& c) {
   return c.axis.allFinite() && std::isfinite(c.half_angle);
@@ -52,7 +62,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (mode == 0) {
       NormalCone c[2];
       for (auto& ci : c) {
-        const Vector3d axis(in.finite_double(), in.finite_double(), in.finite_double());
+        const Vector3d axis = read_vector(in);
         if (!(axis.norm() > 1e-150) || !std::isfinite(axis.norm())) return 0;
         ci = NormalCone{axis.normalized(), std::fmod(std::abs(in.finite_double()), 2.0)};
       }
@@ -62,38 +72,38 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         check_contains(m, c[1]);
       }
     } else if (mode == 1) {
-      Vector3d p[6];
-      const double scale = std::pow(10.0, static_cast<int>(in.byte() % 41) - 20);
-      for (auto& v : p)
-        v = Vector3d(in.finite_double(), in.finite_double(), in.finite_double());
-      for (auto& v : p)
-        v = v.unaryExpr([&](double x) { return std::tanh(x) * scale; });
+      // Scale bytes 0-245 map the coordinates through tanh onto one of 41 decades; 246-255 take
+      // them as given, so a seed can hold an exact input.
+      const std::uint8_t scale_byte = in.byte();
+      const bool raw = scale_byte >= 246;
+      const double scale = std::pow(10.0, static_cast<int>(scale_byte % 41) - 20);
+      std::array<Vector3d, 3> t0, t1;
+      for (auto* side : {&t0, &t1}) {
+        for (auto& v : *side) {
+          for (int j = 0; j < 3; ++j) {
+            const double x = in.finite_double();
+            v[j] = raw ? x : std::tanh(x) * scale;
+          }
+        }
+      }
       for (auto policy : {clothcd::LeafConePolicy::Tang, clothcd::LeafConePolicy::Proposed,
                           clothcd::LeafConePolicy::Exact}) {
-        const NormalCone c = clothcd::ccd_leaf_cone(p[0], p[1], p[2], p[3], p[4], p[5], policy);
+        const NormalCone c =
+            clothcd::ccd_leaf_cone(t0[0], t0[1], t0[2], t1[0], t1[1], t1[2], policy);
         if (std::isnan(c.half_angle)) std::abort();
         if (c.saturated()) continue;
-        for (int k = 0; k <= 16; ++k) {
-          const double t = k / 16.0;
-          const Vector3d a = (1 - t) * p[0] + t * p[3], b = (1 - t) * p[1] + t * p[4],
-                         cc = (1 - t) * p[2] + t * p[5];
-          const Vector3d n = (b - a).cross(cc - a);
-          // The normal computed here in double carries an absolute error of a few eps * M^2
-          // (M: the largest coordinate); where that is not far below |n| its direction is noise
-          // (a fuzzed near-degenerate triangle got the opposite normal), so it is skipped, and
-          // otherwise the allowance grows by the angle that error can turn n.
-          const double m = std::max({a.lpNorm<Eigen::Infinity>(), b.lpNorm<Eigen::Infinity>(),
-                                     cc.lpNorm<Eigen::Infinity>()});
-          const double err = 64 * std::numeric_limits<double>::epsilon() * m * m;
-          const double len = n.stableNorm();
-          if (!(len > 1e3 * err)) continue;
-          if (angle(c.axis, n) > c.half_angle + 1e-7 + 2 * err / len) std::abort();
+        // Against the exact normal at t = k/64: no error model of the check's own (one that
+        // judged the rounding of interpolated positions by their size at t, not at the ends of
+        // the step, once flagged a correct cone).
+        for (int k = 0; k <= 64; ++k) {
+          const auto n = clothcd::test::exact_normal(t0, t1, k, 64);
+          if (n && angle(c.axis, *n) > c.half_angle + 1e-12) std::abort();
         }
       }
     } else {
       std::vector<Vector3d> dirs;
       while (!in.empty() && dirs.size() < 64) {
-        const Vector3d d(in.finite_double(), in.finite_double(), in.finite_double());
+        const Vector3d d = read_vector(in);
         if (d.norm() > 1e-100 && std::isfinite(d.norm())) dirs.push_back(d.normalized());
       }
       const NormalCone c = clothcd::optimal_cone(dirs);

@@ -5,9 +5,11 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "clothcd/geometry/cone.hpp"
 #include "cone_sampling.hpp"
+#include "support/exact_normal.hpp"
 
 namespace clothcd {
 namespace {
@@ -160,6 +162,104 @@ TEST(LeafCone, StaticTriangleGivesTheSameConeForEveryPolicy) {
       ASSERT_LE(c.half_angle, 8 * dcd.half_angle + 4 * kConeSlack) << "seed " << seed;
     }
   }
+}
+
+// Steps chosen where double arithmetic is weakest: the triangle passes near the origin at a time
+// t = k/16 (interpolated coordinates cancel, so their rounding is large against their size), it
+// degenerates mid-step (zero area, the normal flips), or it is tiny and far away; coordinates
+// from 1e-20 to 1e20.
+MovingTriangle adversarial_moving_triangle(Rng& rng) {
+  const double scale = rng.log_uniform(1e-20, 1e20);
+  const double size = rng.log_uniform(1e-14, 1.0);
+  MovingTriangle m;
+  switch (rng.integer(0, 2)) {
+    case 0: {
+      const double t = rng.integer(1, 15) / 16.0;
+      const Eigen::Vector3d start = rng.unit();
+      const Eigen::Vector3d end = -(1 - t) / t * start;
+      for (int i = 0; i < 3; ++i) {
+        m.t0[i] = start + size * rng.unit();
+        m.t1[i] = end + size * rng.unit();
+      }
+      break;
+    }
+    case 1: {
+      // c moves across the line through a and b.
+      for (int i = 0; i < 2; ++i) {
+        m.t0[i] = rng.unit();
+        m.t1[i] = m.t0[i] + size * rng.unit();
+      }
+      const Eigen::Vector3d ab = m.t0[1] - m.t0[0];
+      const Eigen::Vector3d side = rng.perpendicular(ab.normalized());
+      const double lambda = rng.uniform(-0.5, 1.5);
+      m.t0[2] = m.t0[0] + lambda * ab + size * side;
+      m.t1[2] = m.t1[0] + lambda * (m.t1[1] - m.t1[0]) - size * rng.uniform() * side;
+      break;
+    }
+    default: {
+      const Eigen::Vector3d far = rng.unit() * rng.log_uniform(1.0, 1e6);
+      const Eigen::Vector3d motion = rng.unit() * rng.log_uniform(1e-6, 1e6);
+      for (int i = 0; i < 3; ++i) {
+        m.t0[i] = far + size * rng.unit();
+        m.t1[i] = far + motion + size * rng.unit();
+      }
+      break;
+    }
+  }
+  for (int i = 0; i < 3; ++i) {
+    m.t0[i] *= scale;
+    m.t1[i] *= scale;
+  }
+  return m;
+}
+
+// Every non-saturated leaf cone holds the exact normal (rational arithmetic) at each sampled
+// time, within the rounding of the angle computation alone.
+void expect_holds_exact_normal(const MovingTriangle& m, int samples, const std::string& what) {
+  for (const auto policy : kPolicies) {
+    const NormalCone c =
+        ccd_leaf_cone(m.t0[0], m.t0[1], m.t0[2], m.t1[0], m.t1[1], m.t1[2], policy);
+    ASSERT_TRUE(c.axis.allFinite() && std::isfinite(c.half_angle)) << what;
+    if (c.saturated()) continue;
+    for (int k = 0; k <= samples; ++k) {
+      const auto n = test::exact_normal(m.t0, m.t1, k, samples);
+      if (!n) continue;
+      ASSERT_LE(angle_ld(c.axis, *n), c.half_angle + 1e-12L)
+          << what << ", policy " << static_cast<int>(policy) << ", t = " << k << "/" << samples;
+    }
+  }
+}
+
+// A step whose vertices pass near the origin at t = 3/16, where their interpolated coordinates
+// nearly cancel. A check in double that bounded the normal's rounding by the coordinates at t
+// (not at the step's ends, whose rounding the interpolation carries) saw the normal 0.0015 rad
+// outside the EXACT cone; in rational arithmetic the cone holds it at every time. The cone was
+// right and the check was wrong.
+TEST(LeafCone, StepThroughTheOriginHoldsTheExactNormal) {
+  MovingTriangle m;
+  m.t0 = {Eigen::Vector3d(-0x1.a79920c9fc545p-1, 0x1.59d96abaac488p-1, -0x1.69687605ef79cp-1),
+          Eigen::Vector3d(-0x1.a79920c9fc4c3p-1, 0x1.59d96abaac278p-1, -0x1.69687605ef661p-1),
+          Eigen::Vector3d(-0x1.a79920c9fc433p-1, 0x1.59d96abaac089p-1, -0x1.69687605ef4fcp-1)};
+  m.t1 = {Eigen::Vector3d(0x1.cae5e3857bd4cp+1, -0x1.76ab88f4e5267p+1, 0x1.87867fdbc33dbp+1),
+          Eigen::Vector3d(0x1.cae5e3857bdc8p+1, -0x1.76ab88f4e51ecp+1, 0x1.87867fdbc3432p+1),
+          Eigen::Vector3d(0x1.cae5e3857bdbep+1, -0x1.76ab88f4e51d1p+1, 0x1.87867fdbc3313p+1)};
+  const NormalCone exact =
+      ccd_leaf_cone(m.t0[0], m.t0[1], m.t0[2], m.t1[0], m.t1[1], m.t1[2], LeafConePolicy::Exact);
+  ASSERT_FALSE(exact.saturated());  // the case is only a test while the cone is below pi/2
+  expect_holds_exact_normal(m, 4096, "step through the origin");
+}
+
+TEST(LeafCone, CcdConeHoldsTheExactNormalOnAdversarialSteps) {
+  int usable = 0;
+  for (int seed = 0; seed < kCases / 50; ++seed) {
+    Rng rng(seed);
+    const MovingTriangle m = adversarial_moving_triangle(rng);
+    const NormalCone c =
+        ccd_leaf_cone(m.t0[0], m.t0[1], m.t0[2], m.t1[0], m.t1[1], m.t1[2], LeafConePolicy::Exact);
+    usable += c.saturated() ? 0 : 1;
+    expect_holds_exact_normal(m, 32, "seed " + std::to_string(seed));
+  }
+  EXPECT_GT(usable, kCases / 500);  // the check must meet enough cones below pi/2 to mean much
 }
 
 // Regression for erratum 3.4.1: the paper's eq. 10 taken literally (unit N(0), N(1) mixed with
