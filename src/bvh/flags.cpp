@@ -1,5 +1,5 @@
 // Per-node topology flags computed once at build: edge-connectedness (the gate of cone culling)
-// and the disk test with its oriented boundary loop (the contour test, algorithms.md 1.5).
+// and the disk test with its oriented boundary loop (the contour test, docs/algorithms.md 1.5).
 
 #include <algorithm>
 

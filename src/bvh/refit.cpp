@@ -138,7 +138,7 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
     if (!options.cones) return;
     cones_[i] = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, lp);
     if (optimal) {
-      // Bernstein control vectors of the quadratic normal n(t) (algorithms.md 1.3).
+      // Bernstein control vectors of the quadratic normal n(t) (docs/algorithms.md 1.3).
       const Eigen::Vector3d n0 = (b0 - a0).cross(c0 - a0);
       const Eigen::Vector3d n1 = (b1 - a1).cross(c1 - a1);
       const Eigen::Vector3d nx = 0.5 * ((b0 - a0).cross(c1 - a1) + (b1 - a1).cross(c0 - a0));

@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the coplanarity cubic in Bernstein form (algorithms.md section 6.1) with a forward
+// Internal: the coplanarity cubic in Bernstein form (docs/algorithms.md 6.1) with a forward
 // error bound, the NP filter, and the isolation of the times where it may vanish.
 // The triangle is (a, b, c) and the fourth point q: VF uses a, b, c = f0, f1, f2 and q = v;
 // EE uses a, b, c = ea0, ea1, eb0 and q = eb1. Both contacts need det(b - a, c - a, q - a) = 0.

@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the conservative inclusion solver (algorithms.md section 5.2, written from the
+// Internal: the conservative inclusion solver (docs/algorithms.md 5.2, written from the
 // description). F(t, u, v) is the vector between the two closest-point candidates:
 //   VF: F = p - (a + u (b - a) + v (c - a)),  u, v >= 0, u + v <= 1
 //   EE: F = (a + u (b - a)) - (c + v (d - c)),  u, v in [0, 1]

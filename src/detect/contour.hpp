@@ -1,5 +1,5 @@
 #pragma once
-// The continuous contour test of algorithms.md 1.5: the oriented boundary loop of a disk node,
+// The continuous contour test of docs/algorithms.md 1.5: the oriented boundary loop of a disk node,
 // projected along the cone axis, stays star-shaped about its moving centroid over the whole step.
 
 #include <Eigen/Core>
@@ -71,7 +71,7 @@ inline Quadratic det_quadratic(const Eigen::Vector3d& x0, const Eigen::Vector3d&
           kRel * (nx0 * ny0 + nx0 * ny1 + nx1 * ny0 + nx1 * ny1)};
 }
 
-/// The general contour test (algorithms.md 1.5, first rows): the loop, projected along the unit
+/// The general contour test (docs/algorithms.md 1.5): the loop, projected along the unit
 /// `axis`, is a simple closed curve with positive area for every t in [0, 1]. With a cone below
 /// pi/2 every projected triangle is positively oriented, so the number of preimages of a point is
 /// the loop's winding number about it (0 or 1): the projection is injective and the patch cannot

@@ -346,7 +346,7 @@ struct SelfDetector::Impl {
     v1 = v0;
     RefitOptions ro;
     ro.thickness = h;
-    ro.cones = false;  // cones carry no distance information (algorithms.md 1.1)
+    ro.cones = false;  // cones carry no distance information (docs/algorithms.md 1.1)
     bvh.refit(v0, ro);
     detail::FeatureContext ctx;
     ctx.topo = &topo;

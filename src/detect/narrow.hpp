@@ -279,7 +279,7 @@ class FeatureBoxes {
 };
 
 /// Procedural R-triangle of (v, f): the first face of v, ascending, that shares no vertex with f
-/// (algorithms.md 6.3); -1 when every face of v touches f (an orphan).
+/// (docs/algorithms.md 6.3); -1 when every face of v touches f (an orphan).
 inline int vf_representative(const Topology& topo, int v, int f) {
   const Face& tf = topo.faces()[f];
   for (int g : topo.vertex_faces(v)) {

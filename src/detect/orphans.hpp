@@ -1,6 +1,6 @@
 #pragma once
-// Orphan feature pairs (algorithms.md 6.3): VF and EE pairs all of whose triangle pairs share a
-// vertex. The traversal never visits adjacent triangle pairs, so these are tested on their own.
+// Orphan feature pairs (docs/algorithms.md 6.3): VF and EE pairs all of whose triangle pairs share
+// a vertex. The traversal never visits adjacent triangle pairs, so these are tested on their own.
 
 #include <utility>
 #include <vector>

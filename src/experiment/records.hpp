@@ -1,6 +1,6 @@
 #pragma once
 // CSV form of the experiment's records (one header line, comma-separated, no quoting: names are
-// sanitized) and small shared helpers.
+// sanitized) and small shared functions.
 
 #include <filesystem>
 #include <string>

@@ -1,4 +1,4 @@
-// The binary merges of normal cones (algorithms.md 3.1 and 3.2) and cone containment.
+// The binary merges of normal cones (docs/algorithms.md 3.1 and 3.2) and cone containment.
 #include "clothcd/geometry/cone.hpp"
 
 #include <Eigen/Geometry>

@@ -1,5 +1,5 @@
-// Leaf cones: the cone of a triangle's normal over a linear motion (CCD, algorithms.md 3.3) and
-// of a static triangle (DCD).
+// Leaf cones: the cone of a triangle's normal over a linear motion (CCD, docs/algorithms.md 3.3)
+// and of a static triangle (DCD).
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>

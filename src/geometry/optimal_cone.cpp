@@ -1,5 +1,5 @@
 // The optimal (minimal) cone of a set of directions: Welzl's move-to-front algorithm run on the
-// sphere with caps through one, two or three points (algorithms.md 4, "alternatively").
+// sphere with caps through one, two or three points (docs/algorithms.md 4).
 //
 // For caps below pi/2 the minimal cap equals the minimum enclosing ball of the unit tips
 // (B(cos t c, sin t)), so this is the same LP-type problem. Working with caps directly avoids two

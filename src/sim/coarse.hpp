@@ -5,7 +5,7 @@
 // frequency fast; the smooth error, which the stiff membrane spreads over many vertices, is what
 // makes a cold solve long. Off by default (`SolverOptions::coarse_aggregate`): on the garment
 // scenes' warm-started solves it saves 20-41% of the iterations but no time on 2 threads
-// (docs/simulator.md, "Measured", session 15).
+// (docs/simulator.md 2.1).
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>

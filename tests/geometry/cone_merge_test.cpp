@@ -1,4 +1,4 @@
-// Property tests of the binary cone merges (algorithms.md 3.1, 3.2): containment, the paper's
+// Property tests of the binary cone merges (docs/algorithms.md 3.1, 3.2): containment, the paper's
 // Theorem 1 with its exact difference D, and minimality against a brute-force search.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Property tests of the CCD and DCD leaf cones (algorithms.md 3.3, 3.4): each policy holds the
+// Property tests of the CCD and DCD leaf cones (docs/algorithms.md 3.3, 3.4): each policy holds the
 // true normal of a moving triangle at every sampled time, and Exact <= Proposed <= Tang.
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
-// Property tests of the optimal cone (algorithms.md 4): minimal against a brute-force search over
-// every pair and triple, never wider than a hierarchical merge, saturated exactly when the set
+// Property tests of the optimal cone (docs/algorithms.md 4): minimal against a brute-force search
+// over every pair and triple, never wider than a hierarchical merge, saturated exactly when the set
 // spans a hemisphere, and deterministic.
 #include <gtest/gtest.h>
 

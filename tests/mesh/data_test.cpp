@@ -38,7 +38,7 @@ TEST(MeshData, ClothBallFramesAgainstOtherGarment) {
 TEST(MeshData, DressStageStitches) {
   CLOTHCD_REQUIRE_DATA(stage, "garments/dress_knife/stage.obj");
   const ObjContents c = read_obj_with_stitches(stage);
-  // simulator.md section 0: 15,656 vertices, 29,456 triangles, 851 stitches.
+  // docs/simulator.md 0: 15,656 vertices, 29,456 triangles, 851 stitches.
   EXPECT_EQ(c.mesh.num_vertices(), 15656);
   EXPECT_EQ(c.mesh.num_faces(), 29456);
   EXPECT_EQ(c.stitches.size(), 851u);
@@ -74,8 +74,8 @@ struct Garment {
   bool exactly_apart;  // no two vertices coincide within 1e-9
 };
 
-// Issue 4: at 0.1 mm each garment sews into one edge-connected sheet; at 1e-9 the panels stay
-// apart (simulator.md section 0: 14 panels for the dress, 10 for the multilayer).
+// At 0.1 mm each garment sews into one edge-connected sheet; at 1e-9 the panels stay
+// apart (docs/simulator.md 0: 14 panels for the dress, 10 for the multilayer).
 TEST(MeshData, GarmentsSewIntoOneSheet) {
   for (const Garment g : {Garment{"garments/dress_knife/drape.obj", 15656, 29456, 14, true},
                           Garment{"garments/multilayer/drape.obj", 30464, 58687, 10, false}}) {

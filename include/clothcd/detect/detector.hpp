@@ -17,7 +17,7 @@ namespace clothcd {
 /// n x 3 vertex positions, one row per vertex.
 using Positions = Eigen::MatrixXd;
 
-/// Proximity pairs: features closer than h at one instant (no cone culling: algorithms.md 1.1).
+/// Proximity pairs: features closer than h at one instant (no cones: docs/algorithms.md 1.1).
 struct ProximityResult {
   struct VertexFace {
     int vertex, face;

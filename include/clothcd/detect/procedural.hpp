@@ -5,7 +5,7 @@
 /// - stacked sheets: two disconnected sheets with parallel normals pass through each other; the
 ///   paper's cone-only rule culls the pair, the connectivity gate does not;
 /// - winding strip: a connected strip that winds more than once around an axis with all its
-///   normals near the axis (algorithms.md 1.1); the gated cone rule culls it, the contour test
+///   normals near the axis (docs/algorithms.md 1.1); the gated cone rule culls it, the contour test
 ///   does not;
 /// - crumpled sheet: a sheet folding onto itself under a random smooth displacement;
 /// - twisted strip: a twisted strip coiled so that its ends cross.

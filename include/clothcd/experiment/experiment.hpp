@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The experiment harness (issue 6): runs every detector configuration (cone policy x culling
+/// The experiment harness: runs every detector configuration (cone policy x culling
 /// rule x BVH build, plus the unculled reference) over the very same recorded frames, records
 /// every figure per step, and writes the paper's Tables 1-2, a misses table and the data of
 /// Figures 5-6. Results are kept per (scene, build) under OUT/runs/ and rewritten atomically

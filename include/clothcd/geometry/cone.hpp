@@ -2,7 +2,7 @@
 /// @file
 /// Normal cones and their algebra: the merges of Provot (PROVOT) and of Han et al. 2021
 /// (PROPOSED), the CCD leaf cones, and the optimal cone of a vector set (Barequet-Elber).
-/// See docs/algorithms.md (shared) sections 3 and 4 for the formulas and the paper's errata, and
+/// See docs/algorithms.md sections 3 and 4 for the formulas and the paper's errata, and
 /// docs/cones.md for the numerical choices made here.
 ///
 /// Conventions shared by every function below:

@@ -13,7 +13,7 @@
 
 namespace clothcd::sim {
 
-/// Physical parameters; defaults are the "Defaults for clothcd" table of docs/simulator.md.
+/// Physical parameters; defaults as in docs/simulator.md 1.5.
 struct ClothMaterial {
   double area_density = 0.15;         ///< rho_A, kg/m^2
   double stretch_stiffness = 260.0;   ///< E*t, N/m

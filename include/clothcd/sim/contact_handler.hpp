@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The collision stage (docs/simulator.md 3; reference ../shared/docs/simulator.md 3): per
+/// The collision stage (docs/simulator.md 3): per
 /// substep, proximity repulsion and friction within the cloth thickness, then CCD passes whose
 /// hits accumulate as linearized constraints that projected Gauss-Seidel satisfies together
 /// (inelastic projection, Harmon et al. 2008; the impulses are those of Bridson, Fedkiw,

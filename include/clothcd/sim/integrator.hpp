@@ -39,13 +39,13 @@ struct SolverOptions {
   /// residual (or pcg_tolerance, if larger): it only decides which of them to let go, and the
   /// solve redone after that reaches pcg_tolerance. On multilayer-rumba frames 61-64 a complete
   /// first solve (73 iterations a substep) was followed by a redo of 43 in every substep; with
-  /// 1e-2 they took 18 and 64 (docs/simulator.md, "Measured"). At or below pcg_tolerance: the
-  /// complete first solve, redone only when something was let go (as before session 14).
+  /// 1e-2 they took 18 and 64 (docs/simulator.md 2.1). At or below pcg_tolerance: the
+  /// complete first solve, redone only when something was let go.
   double release_tolerance = 1e-2;
   /// The PCG tolerance of the substeps of a fast frame (ClothSolver::step's `fast`): one that
   /// the substep rule gave more than its minimum of substeps, so that each substep moves the body
   /// or the cloth as far as the rule allows and the time step's own error outweighs the solve's
-  /// (docs/simulator.md, "Measured", session 19). 0: pcg_tolerance in every frame.
+  /// (docs/simulator.md 2.1). 0: pcg_tolerance in every frame.
   double fast_pcg_tolerance = 0.0;
   /// Vertices per aggregate of the PCG's coarse correction (a two-level preconditioner: block
   /// Jacobi plus one translation per aggregate, factored every substep); 0: block Jacobi alone.
