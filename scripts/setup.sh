@@ -1,14 +1,25 @@
 #!/usr/bin/env bash
 # Installs the Debian packages clothcd needs; does nothing when they are all present.
+# Usage: scripts/setup.sh [demo|test|full]
+#   demo: the library and the command-line tool; test (default): also the test suite's needs;
+#   full: also the benchmarks and the clang sanitizer and fuzzing tree (test.sh --full).
 set -euo pipefail
 
+profile=${1:-test}
 packages=(
   cmake g++ make pkg-config
   libeigen3-dev libtbb-dev libfmt-dev libcli11-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libgmp-dev
-  clang clang-format libclang-rt-14-dev
-  python3-matplotlib
 )
+case "$profile" in
+  demo) ;;
+  test | full)
+    packages+=(libgtest-dev libgmock-dev libgmp-dev clang-format python3-matplotlib)
+    if [ "$profile" = full ]; then
+      packages+=(libbenchmark-dev clang libclang-rt-14-dev)
+    fi
+    ;;
+  *) echo "setup.sh: unknown profile '$profile' (expected demo, test or full)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

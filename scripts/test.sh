@@ -39,7 +39,7 @@ if [ -n "${CI:-}" ] && [ ! -d "$data" ]; then
 fi
 
 stage "Setup"
-scripts/setup.sh
+if [ "$full" = 1 ]; then scripts/setup.sh full; else scripts/setup.sh test; fi
 
 # Runs ctest with the given arguments, prints how many tests ran and skipped, and (under CI) fails
 # on any skip: skipping is how a data test would pass without its data.
@@ -63,7 +63,8 @@ run_ctest() {
 stage "Release build"
 bench=OFF
 [ "$full" = 1 ] && bench=ON
-cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DCLOTHCD_BUILD_BENCH=$bench >/dev/null
+cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DCLOTHCD_BUILD_TESTS=ON \
+  -DCLOTHCD_BUILD_APPS=ON -DCLOTHCD_BUILD_BENCH=$bench >/dev/null
 cmake --build build/release -j "$jobs"
 cmake --build build/release --target format-check
 
