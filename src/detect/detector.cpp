@@ -11,6 +11,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "clearance.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "contour.hpp"
 #include "narrow.hpp"
@@ -87,15 +88,63 @@ struct SelfDetector::Impl {
     owner = detail::Ownership(topo);
   }
 
-  [[nodiscard]] bool cones_used(Culling mode) const {
-    return mode != Culling::None && !(mode == Culling::Sound && opt.thickness > 0);
-  }
+  [[nodiscard]] bool cones_used(Culling mode) const { return mode != Culling::None; }
 
-  // Pairs kept for reuse: only when no cone culls, so the traversal lists every overlapping leaf
-  // pair; the boxes then reach at least reuse_distance.
-  [[nodiscard]] bool keeps() const { return opt.reuse_distance > 0 && !cones_used(opt.culling); }
+  // Pairs kept for reuse: not with the unsound rules, which may cull close pairs. Sound culling
+  // then certifies its nodes free of feature pairs within reuse_distance too (cull_reach()), so
+  // the list holds every overlapping leaf pair that can matter; the boxes reach reuse_distance.
+  [[nodiscard]] bool keeps() const {
+    return opt.reuse_distance > 0 &&
+           (opt.culling == Culling::None || opt.culling == Culling::Sound);
+  }
   [[nodiscard]] double box_reach() const {
     return keeps() ? std::max(opt.thickness, opt.reuse_distance) : opt.thickness;
+  }
+
+  // Sound culling with a contact distance (docs/algorithms.md 1.6): at thickness 0 and without
+  // reuse, the contour test alone proves a node free of contacts; otherwise a node must also
+  // keep its non-adjacent features farther apart than the node's reach.
+  [[nodiscard]] bool culls_with_reach() const {
+    return opt.culling == Culling::Sound && (opt.thickness > 0 || keeps());
+  }
+
+  // How close two features of node n may come before the narrow phase could report them: a
+  // kernel hit certifies a distance of at most sqrt(3) (thickness + tolerance * extent), the
+  // extent being at most the node box's longest side; a kept pair matters within reuse_distance.
+  [[nodiscard]] double cull_reach(const BvhNode& n) const {
+    double extent = 0, scale = 0;
+    for (int k = 0; k < 3; ++k) {
+      extent = std::max(extent, n.hi[k] - n.lo[k]);
+      scale = std::max({scale, std::abs(n.lo[k]), std::abs(n.hi[k])});
+    }
+    const double kernel = std::sqrt(3.0) * (opt.thickness + CcdOptions{}.tolerance * extent);
+    const double reach = std::max(kernel, keeps() ? opt.reuse_distance : 0.0);
+    return reach * (1 + 1e-9) + detail::kClearanceRounding * scale;
+  }
+
+  // The smallest corner clearance (docs/algorithms.md 1.6) of the triangles below each node over
+  // the current step; children come after their parent, so one reverse pass fills the nodes.
+  std::vector<double> node_clearance;
+  void update_clearances() {
+    const auto& nodes = bvh.nodes();
+    const auto& prims = bvh.prim_ids();
+    const auto& faces = topo.faces();
+    node_clearance.resize(nodes.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          if (!nodes[i].is_leaf()) continue;
+                          const Face& f = faces[prims[nodes[i].first]];
+                          node_clearance[i] = detail::triangle_corner_clearance(
+                              detail::corners(v0, f), detail::corners(v1, f));
+                        }
+                      });
+    for (std::size_t i = nodes.size(); i-- > 0;) {
+      const BvhNode& n = nodes[i];
+      if (!n.is_leaf()) {
+        node_clearance[i] = std::min(node_clearance[n.left], node_clearance[n.left + 1]);
+      }
+    }
   }
 
   [[nodiscard]] bool vf_in_scope(int v, int f) const {
@@ -111,6 +160,7 @@ struct SelfDetector::Impl {
     const auto& prims = bvh.prim_ids();
     const auto& cones = bvh.cones();
     const bool use_cones = cones_used(mode);
+    const bool with_reach = mode == Culling::Sound && culls_with_reach();
     auto cull = [&](int i, detail::TraversalCounters& c) {
       if (!use_cones) return false;
       const BvhNode& n = nodes[i];
@@ -122,8 +172,14 @@ struct SelfDetector::Impl {
       if (mode != Culling::Sound) return true;
       ++c.contour_tests;
       // The star test is O(contour); the general simplicity test catches what it cannot.
-      const bool ok = detail::contour_star_shaped(bvh.contour(i), v0, v1, k.axis) ||
-                      detail::contour_simple(bvh.contour(i), v0, v1, k.axis);
+      bool ok = detail::contour_star_shaped(bvh.contour(i), v0, v1, k.axis) ||
+                detail::contour_simple(bvh.contour(i), v0, v1, k.axis);
+      if (ok && with_reach) {
+        // Projected distances are at least cos(half angle) times the 3-D corner clearances.
+        const double reach = cull_reach(n);
+        ok = std::cos(k.half_angle) * node_clearance[i] > reach &&
+             detail::contour_clear(bvh.contour(i), v0, v1, k.axis, reach);
+      }
       if (!ok) ++c.contour_fails;
       return ok;
     };
@@ -300,6 +356,7 @@ struct SelfDetector::Impl {
     ro.cones = cones_used(opt.culling);
     ro.policy = opt.policy;
     bvh.refit_changed(v0, v1, ro);
+    if (culls_with_reach()) update_clearances();
     st.time_refit = seconds_since(t);
     st.internal_nodes = bvh.num_internal();
     st.connected_internal_nodes = bvh.num_connected_internal();

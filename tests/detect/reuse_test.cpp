@@ -183,10 +183,10 @@ TEST(ProximityReuse, OffWhereItCannotHold) {
     expect_same(r, ref);
   }
   {
-    SCOPED_TRACE("cone culling (zero thickness) lists fewer pairs than the boxes overlap");
-    DetectOptions sound = o;
-    sound.culling = Culling::Sound;
-    SelfDetector det(s.faces, s.num_vertices, s.v_t0, sound);
+    SCOPED_TRACE("the unsound cone rule may cull close pairs");
+    DetectOptions cone = o;
+    cone.culling = Culling::Cone;
+    SelfDetector det(s.faces, s.num_vertices, s.v_t0, cone);
     static_cast<void>(det.detect(s.v_t0, end));
     const ProximityResult r = det.proximity(end, kKept);
     EXPECT_EQ(r.reused_pairs, 0u);
@@ -207,6 +207,42 @@ TEST(ProximityReuse, OffWhereItCannotHold) {
     expect_same(r, r_ref);
     EXPECT_LT(r.vf.size() + r.ee.size(), ref.vf.size() + ref.ee.size());
   }
+}
+
+// Sound culling certifies its culled nodes free of feature pairs within the reuse distance, so
+// the pairs it keeps still serve the proximity query: cones and reuse work together.
+TEST(ProximityReuse, SoundCullingKeepsWhatTheQueryNeeds) {
+  std::uint64_t culled = 0, reused = 0;
+  for (const ProceduralScene& s : scenes()) {
+    for (const double reuse : {0.002, kKept}) {
+      SCOPED_TRACE(::testing::Message() << s.name << " reuse distance " << reuse);
+      const Topology topo(s.faces, s.num_vertices);
+      const Positions end = 0.5 * (s.v_t0 + s.v_t1);
+      DetectOptions o;
+      o.reuse_distance = reuse;
+      o.culling = Culling::Sound;
+      o.build = BvhBuild::Patch;
+      DetectOptions plain = o;
+      plain.culling = Culling::None;
+      SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+      SelfDetector ref_det(s.faces, s.num_vertices, s.v_t0, plain);
+      const DetectResult r = det.detect(s.v_t0, end);
+      const DetectResult r_ref = ref_det.detect(s.v_t0, end);
+      EXPECT_EQ(r.vf, r_ref.vf);
+      EXPECT_EQ(r.ee, r_ref.ee);
+      culled += r.stats.nodes_culled;
+      for (const double share : {0.0, 0.1}) {
+        const Positions at = moved(end, share, 0.01, 7);
+        const ProximityResult p = det.proximity(at, reuse);
+        reused += p.reused_pairs;
+        expect_same(p, brute_force_proximity(topo, at, reuse));
+        static_cast<void>(det.detect(s.v_t0, end));  // keep the pairs again for the next query
+      }
+    }
+  }
+  // The cones did cull and the queries did take kept pairs, or the test shows nothing.
+  EXPECT_GT(culled, 0u);
+  EXPECT_GT(reused, 0u);
 }
 
 TEST(ProximityReuse, RejectsBadDistances) {

@@ -16,15 +16,18 @@ enum class Culling {
   None,   ///< boxes only
   Cone,   ///< the paper's literal rule: cone below pi/2 (unsound)
   Gated,  ///< cone below pi/2 on edge-connected nodes only (still unsound: the winding strip)
-  Sound,  ///< gated, on disk nodes, plus the contour test: finds exactly what None finds
+  Sound,  ///< gated, on disk nodes, plus the contour test (and, with a thickness or a reuse
+          ///< distance, clearances that keep culled features out of reach): finds exactly what
+          ///< None finds
 };
 
 struct DetectOptions {
   ConePolicy policy = ConePolicy::Proposed;
   Culling culling = Culling::None;
   BvhBuild build = BvhBuild::Spatial;
-  /// Contact distance of the CCD kernels; boxes grow with it. Cone culling needs zero thickness
-  /// to be sound, so Culling::Sound culls nothing when thickness > 0.
+  /// Contact distance of the CCD kernels; boxes grow with it. Culling::Sound stays exact at any
+  /// thickness: it then culls only nodes whose features provably stay out of the kernels' reach
+  /// (docs/algorithms.md 1.6).
   double thickness = 0.0;
   /// Deforming NP filter before the kernels (applied at zero thickness only).
   bool np_filter = true;
@@ -36,10 +39,11 @@ struct DetectOptions {
   /// Bisections of the distance filter (`distance_filter_culls` depth) when thickness > 0: each
   /// level can cull near misses the whole-step bound cannot, before the costlier kernel runs.
   int distance_filter_depth = 0;
-  /// A simulator's shortcut, results unchanged: when > 0 (and no cone culls), an unrestricted
-  /// detect() widens its candidate boxes to at least this distance and keeps its triangle pairs,
-  /// so that a following proximity(v, h) with h <= reuse_distance traverses only near the
-  /// vertices whose position in v differs from theirs at t1 (all of them when over a quarter do).
+  /// A simulator's shortcut, results unchanged: when > 0 (with Culling::None or Sound), an
+  /// unrestricted detect() widens its candidate boxes to at least this distance and keeps its
+  /// triangle pairs, so that a following proximity(v, h) with h <= reuse_distance traverses only
+  /// near the vertices whose position in v differs from theirs at t1 (all of them when over a
+  /// quarter do).
   double reuse_distance = 0.0;
   /// Also run the unculled traversal and report what the culled one missed.
   bool verify = false;

@@ -1,0 +1,124 @@
+#pragma once
+// Clearances for sound cone culling with a contact distance R > 0 (docs/algorithms.md 1.6): a
+// lower bound, over the whole step, on how close a patch's features can come to the features they
+// do not touch. Every bound is a distance at t = 0 and at t = 1 and a Lipschitz constant of the
+// motion: a distance that is d0 at t = 0, d1 at t = 1 and changes at most at rate L is at least
+// (d0 + d1 - L) / 2 throughout.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <span>
+#include <vector>
+
+namespace clothcd::detail {
+
+// Relative rounding allowance of the short distance expressions below (a few ulps of the
+// coordinates, far below this).
+inline constexpr double kClearanceRounding = 1e-12;
+
+/// Distance from p to the segment [a, b], in any dimension.
+template <class Vec>
+[[nodiscard]] double point_segment_distance(const Vec& p, const Vec& a, const Vec& b) {
+  const Vec ab = b - a;
+  const double len2 = ab.squaredNorm();
+  double s = len2 > 0 ? (p - a).dot(ab) / len2 : 0.0;
+  s = std::clamp(s, 0.0, 1.0);
+  return (p - (a + s * ab)).norm();
+}
+
+/// Lower bound over the step of the distance from a linearly moving point p to a linearly moving
+/// segment [a, b]: the distance is 1-Lipschitz in p and moves by at most max(|da|, |db|) when
+/// the segment's ends move by da and db.
+template <class Vec>
+[[nodiscard]] double moving_point_segment_clearance(const Vec& p0, const Vec& p1, const Vec& a0,
+                                                    const Vec& a1, const Vec& b0, const Vec& b1) {
+  const double d0 = point_segment_distance(p0, a0, b0);
+  const double d1 = point_segment_distance(p1, a1, b1);
+  const double rate = (p1 - p0).norm() + std::max((a1 - a0).norm(), (b1 - b0).norm());
+  return 0.5 * (d0 + d1 - rate);
+}
+
+/// The smallest clearance of a corner of triangle (a, b, c) over the step: the distance from each
+/// vertex to the opposite edge, in 3-D, with the rounding allowance taken off.
+[[nodiscard]] inline double triangle_corner_clearance(
+    const std::array<const Eigen::Vector3d*, 3>& x0,
+    const std::array<const Eigen::Vector3d*, 3>& x1) {
+  double clearance = std::numeric_limits<double>::infinity();
+  double scale = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    clearance = std::min(
+        clearance, moving_point_segment_clearance(*x0[i], *x1[i], *x0[j], *x1[j], *x0[k], *x1[k]));
+    scale = std::max({scale, x0[i]->lpNorm<Eigen::Infinity>(), x1[i]->lpNorm<Eigen::Infinity>()});
+  }
+  return clearance - kClearanceRounding * scale;
+}
+
+/// True when, projected along the unit `axis`, every vertex of the contour loop stays farther than
+/// `reach` from every loop edge that does not end at it, over the whole step. Pairs of edges whose
+/// swept 2-D boxes, grown by `reach`, do not overlap are apart by more than `reach` throughout;
+/// the others are bounded as moving segments (for segments that do not cross, the distance is the
+/// smallest of the four endpoint-to-segment distances; the caller has shown they never cross).
+[[nodiscard]] inline bool contour_clear(std::span<const int> loop,
+                                        std::span<const Eigen::Vector3d> v0,
+                                        std::span<const Eigen::Vector3d> v1,
+                                        const Eigen::Vector3d& axis, double reach) {
+  const int n = static_cast<int>(loop.size());
+  if (n < 3) return false;
+  const Eigen::Vector3d u = axis.unitOrthogonal();
+  const Eigen::Vector3d w = axis.cross(u);
+  std::vector<Eigen::Vector2d> p0(n), p1(n);
+  double scale = 0;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d &x0 = v0[loop[i]], &x1 = v1[loop[i]];
+    p0[i] = {x0.dot(u), x0.dot(w)};
+    p1[i] = {x1.dot(u), x1.dot(w)};
+    scale = std::max({scale, x0.lpNorm<Eigen::Infinity>(), x1.lpNorm<Eigen::Infinity>()});
+  }
+  const double need = reach + kClearanceRounding * scale;
+  auto clear = [&](int p, int a, int b) {
+    return moving_point_segment_clearance(p0[p], p1[p], p0[a], p1[a], p0[b], p1[b]) > need;
+  };
+  // A vertex against the edge after next and the edge before last (the two edges that share an
+  // end with one of its own edges).
+  for (int i = 0; i < n; ++i) {
+    const int a = (i + n - 1) % n, c = (i + 1) % n;
+    if (!clear(a, i, c) || !clear(c, a, i)) return false;
+  }
+  struct Box {
+    Eigen::Vector2d lo, hi;
+    int edge;
+  };
+  std::vector<Box> boxes(n);
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    Box& b = boxes[i];
+    b.lo = p0[i].cwiseMin(p1[i]).cwiseMin(p0[j]).cwiseMin(p1[j]).array() - need;
+    b.hi = p0[i].cwiseMax(p1[i]).cwiseMax(p0[j]).cwiseMax(p1[j]).array() + need;
+    b.edge = i;
+  }
+  std::sort(boxes.begin(), boxes.end(), [](const Box& x, const Box& y) {
+    return x.lo[0] < y.lo[0] || (x.lo[0] == y.lo[0] && x.edge < y.edge);
+  });
+  for (int k = 0; k < n; ++k) {
+    const Box& bi = boxes[k];
+    for (int m = k + 1; m < n && boxes[m].lo[0] <= bi.hi[0]; ++m) {
+      const Box& bj = boxes[m];
+      if (bj.lo[1] > bi.hi[1] || bi.lo[1] > bj.hi[1]) continue;
+      const int i = bi.edge, j = bj.edge;
+      if ((i + 1) % n == j || (j + 1) % n == i) continue;  // consecutive: checked above
+      const int i2 = (i + 1) % n, j2 = (j + 1) % n;
+      if (!clear(i, j, j2) || !clear(i2, j, j2) || !clear(j, i, i2) || !clear(j2, i, i2)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace clothcd::detail
