@@ -107,8 +107,8 @@ OutputLock::OutputLock(std::filesystem::path folder) : folder_(std::move(folder)
     const int err = errno;
     if (w >= 0) ::close(w);
     release();
-    throw OutputError(fmt::format("cannot write to output folder '{}': '{}': {}",
-                                  folder_.string(), file.string(), std::strerror(err)));
+    throw OutputError(fmt::format("cannot write to output folder '{}': '{}': {}", folder_.string(),
+                                  file.string(), std::strerror(err)));
   }
   ::close(w);
 }
@@ -124,8 +124,8 @@ void OutputLock::release() noexcept {
   // before its first frame leaves no output. (Not without the lock: another run may own it.)
   if (created_ && locked_) {
     bool only_lock = true;
-    for (const auto& e : fs::directory_iterator(folder_, ec)) {
-      if (e.path().filename() != kLockName) only_lock = false;
+    for (fs::directory_iterator it(folder_, ec), end; !ec && it != end; it.increment(ec)) {
+      if (it->path().filename() != kLockName) only_lock = false;
     }
     if (!ec && only_lock) {
       fs::remove(folder_ / kLockName, ec);

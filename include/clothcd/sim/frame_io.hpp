@@ -21,8 +21,9 @@ namespace clothcd::sim {
 /// write one folder: `FOLDER/.lock` is locked with flock(2), which the kernel releases when the
 /// process ends in any way (a killed run never blocks its resume). Creates the folder when
 /// missing, and removes it again on release when nothing but the lock file was put in it.
-/// Throws std::runtime_error naming the folder when another process holds it, and OutputError
-/// when the folder cannot be created or the lock file opened.
+/// Throws std::runtime_error naming the folder (and the holder's process id) when another process
+/// holds it, and OutputError with the reason when the folder cannot be created or the lock file
+/// opened or written (which finds a read-only folder before any work is done).
 class OutputLock {
  public:
   explicit OutputLock(std::filesystem::path folder);
