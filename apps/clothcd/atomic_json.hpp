@@ -1,7 +1,7 @@
 #pragma once
-// JSON outputs of the subcommands go through the mesh writers' atomic write: a temporary file
-// beside the target, checked after writing and after closing (where a full disk shows), renamed
-// over the target, and removed on any failure, so no partial or empty JSON is ever left.
+// JSON outputs of the subcommands go through the shared atomic writer
+// (clothcd/core/atomic_file.hpp) as the mesh writers do, failures being InputErrors like theirs: no
+// partial or empty JSON is ever left, and the error gives the operating system's reason.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>

@@ -94,7 +94,11 @@ const bool registered = clothcd::app::register_command(
           limit.emplace(tbb::global_control::max_allowed_parallelism,
                         static_cast<std::size_t>(args->threads));
         }
-        clothcd::sim::Simulation sim(clothcd::sim::load_scene(args->scene));
+        clothcd::sim::Scene scene = clothcd::sim::load_scene(args->scene);
+        // Locked before the (possibly slow) setup, so that a second run on the folder refuses
+        // at once; after the scene is read, so that a bad scene leaves no folder behind.
+        const clothcd::sim::OutputLock lock(args->out);
+        clothcd::sim::Simulation sim(std::move(scene));
         const auto& m = sim.model();
         fmt::print(
             stderr,
@@ -122,6 +126,7 @@ const bool registered = clothcd::app::register_command(
         opt.resume = args->resume || args->resume_at >= 0;
         opt.resume_at = args->resume_at;
         opt.keep_states = args->keep_states;
+        opt.lock = &lock;
         if (args->resume && args->resume_at < 0 &&
             !std::filesystem::exists(opt.out / "manifest.json")) {
           fmt::print(stderr, "no manifest in {}: starting from frame 0\n", args->out);

@@ -11,7 +11,6 @@
 #include <sstream>
 
 #include "clothcd/core/error.hpp"
-#include "clothcd/sim/frame_io.hpp"
 
 namespace clothcd::experiment {
 namespace {
@@ -239,10 +238,6 @@ std::string spread_rows_csv(const std::vector<SpreadRow>& rows) {
                        num(r.ms_refit));
   }
   return out;
-}
-
-void write_text_atomic(const std::filesystem::path& path, const std::string& text) {
-  sim::write_file_atomic(path, [&](std::ostream& o) { o << text; });
 }
 
 }  // namespace detail

@@ -7,6 +7,7 @@
 #include <map>
 #include <numeric>
 
+#include "clothcd/core/atomic_file.hpp"
 #include "clothcd/experiment/experiment.hpp"
 #include "records.hpp"
 
@@ -427,13 +428,13 @@ void write_reports(const std::vector<Sequence>& scenes, const ExperimentOptions&
     rows.insert(rows.end(), d.rows.begin(), d.rows.end());
     spread.insert(spread.end(), d.spread.begin(), d.spread.end());
   }
-  detail::write_text_atomic(opt.out / "steps.csv", detail::step_rows_csv(rows));
-  detail::write_text_atomic(opt.out / "spread.csv", detail::spread_rows_csv(spread));
-  detail::write_text_atomic(opt.out / "table1.md", table1(data, opt));
-  detail::write_text_atomic(opt.out / "table2.md", table2(data, opt));
-  detail::write_text_atomic(opt.out / "misses.md", misses(data, opt));
-  detail::write_text_atomic(opt.out / "spread.md", spread_table(data, opt));
-  detail::write_text_atomic(opt.out / "summary.md", summary(data, opt));
+  write_file_atomic(opt.out / "steps.csv", detail::step_rows_csv(rows));
+  write_file_atomic(opt.out / "spread.csv", detail::spread_rows_csv(spread));
+  write_file_atomic(opt.out / "table1.md", table1(data, opt));
+  write_file_atomic(opt.out / "table2.md", table2(data, opt));
+  write_file_atomic(opt.out / "misses.md", misses(data, opt));
+  write_file_atomic(opt.out / "spread.md", spread_table(data, opt));
+  write_file_atomic(opt.out / "summary.md", summary(data, opt));
 }
 
 std::string run_plots(const fs::path& out, const fs::path& script, const std::string& python) {

@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "clothcd/bvh/bvh.hpp"
+#include "clothcd/core/atomic_file.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/experiment/experiment.hpp"
 #include "records.hpp"
@@ -272,8 +273,8 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
       std::stable_sort(srows.begin(), srows.end(),
                        [](const SpreadRow& a, const SpreadRow& b) { return a.step < b.step; });
       // Spread first: the step counts as done once its detection rows are on disk.
-      detail::write_text_atomic(sfile, detail::spread_rows_csv(srows));
-      detail::write_text_atomic(file, detail::step_rows_csv(rows));
+      write_file_atomic(sfile, detail::spread_rows_csv(srows));
+      write_file_atomic(file, detail::step_rows_csv(rows));
       ++done;
       if (on_progress) on_progress({done, total, true, what});
     }

@@ -3,15 +3,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <system_error>
 
-#include <unistd.h>
-
+#include "clothcd/core/atomic_file.hpp"
 #include "clothcd/core/error.hpp"
 
 namespace clothcd::io_detail {
@@ -37,43 +35,10 @@ std::string read_file(const fs::path& path) {
 }
 
 void write_atomically(const fs::path& path, const std::function<void(std::ostream&)>& body) {
-  const std::string name = path.string();
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) throw input_error(name, 0, "cannot write: is a directory");
-  // Unique per process and call, in the target's folder so the rename stays on one file system.
-  static std::atomic<unsigned> counter{0};
-  fs::path tmp = path;
-  tmp += fmt::format(".tmp-{}-{}", static_cast<long>(::getpid()), counter++);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      throw input_error(
-          name, 0,
-          fmt::format("cannot write (temporary file {}): {}", tmp.string(), std::strerror(errno)));
-    }
-    try {
-      body(out);
-    } catch (...) {
-      out.close();
-      fs::remove(tmp, ec);
-      throw;
-    }
-    out.flush();
-    const bool wrote = static_cast<bool>(out);
-    out.close();
-    if (!wrote || out.fail()) {
-      const int err = errno;
-      fs::remove(tmp, ec);
-      throw input_error(name, 0,
-                        fmt::format("write failed (disk full or I/O error?): {}",
-                                    err != 0 ? std::strerror(err) : "stream error"));
-    }
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw input_error(name, 0, fmt::format("cannot replace the file: {}", ec.message()));
+  try {
+    write_file_atomic(path, body);
+  } catch (const OutputError& e) {
+    throw InputError(e.what());  // the mesh writers' contract: every failure is an InputError
   }
 }
 

@@ -31,9 +31,8 @@ bool parse_int(std::string_view token, Int& out) {
   return ec == std::errc() && ptr == token.data() + token.size();
 }
 
-/// Writes through `body` into a temporary file beside `path`, checks the stream after writing and
-/// after closing (a full disk shows there), then renames it over `path`. On any failure the
-/// temporary file is removed and InputError names `path`.
+/// write_file_atomic (clothcd/core/atomic_file.hpp), with its OutputError turned into an
+/// InputError naming `path` and the operating system's reason.
 void write_atomically(const std::filesystem::path& path,
                       const std::function<void(std::ostream&)>& body);
 

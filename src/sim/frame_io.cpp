@@ -1,7 +1,10 @@
 // Atomic output files, the binary state, the manifest and the run loop with resume.
 #include "clothcd/sim/frame_io.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <bit>
 #include <cerrno>
@@ -9,20 +12,43 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 
+#include "clothcd/core/atomic_file.hpp"
 #include "clothcd/core/error.hpp"
 
 namespace clothcd::sim {
 namespace {
 
 constexpr char kStateMagic[8] = {'C', 'L', 'O', 'T', 'H', 'S', 'T', '1'};
+constexpr const char* kLockName = ".lock";
 
 std::string frame_name(int frame, const std::string& ext) {
   return fmt::format("frame_{:04d}.{}", frame, ext);
 }
 std::string state_name(int frame) {
   return fmt::format("state_{:04d}.bin", frame);
+}
+
+// The commit point of a frame (see run_simulation).
+void write_manifest(const std::filesystem::path& path, const nlohmann::json& manifest) {
+  write_file_atomic(path, manifest.dump(1) + '\n', Durability::sync);
+}
+
+// What a killed run can leave: temporary files of the atomic writer (and the fixed `NAME.tmp` of
+// earlier versions) for the frame, state and manifest files. Only called with the folder locked.
+void remove_temporaries(const std::filesystem::path& folder) {
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(folder, ec)) {
+    const std::string name = e.path().filename().string();
+    const bool ours = name.starts_with("frame_") || name.starts_with("state_") ||
+                      name.starts_with("manifest.json");
+    if (ours && (is_atomic_write_temporary(name) || name.ends_with(".tmp"))) {
+      std::error_code ignored;
+      std::filesystem::remove(e.path(), ignored);
+    }
+  }
 }
 
 template <typename T>
@@ -37,37 +63,82 @@ void put_vecs(std::ostream& out, const std::vector<Vec3>& xs) {
 
 }  // namespace
 
-void write_file_atomic(const std::filesystem::path& path,
-                       const std::function<void(std::ostream&)>& write) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      throw std::runtime_error(
-          fmt::format("cannot create '{}': {}", tmp.string(), std::strerror(errno)));
-    }
-    write(out);
-    out.flush();
-    out.close();
-    if (out.fail()) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw std::runtime_error(
-          fmt::format("writing '{}' failed (disk full or output not writable?)", path.string()));
-    }
-  }
+OutputLock::OutputLock(std::filesystem::path folder) : folder_(std::move(folder)) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error(
-        fmt::format("cannot rename '{}' to '{}': {}", tmp.string(), path.string(), ec.message()));
+  created_ = !fs::exists(folder_, ec);
+  fs::create_directories(folder_, ec);
+  if (ec || !fs::is_directory(folder_)) {
+    throw OutputError(fmt::format("cannot create output folder '{}': {}", folder_.string(),
+                                  ec ? ec.message() : "a file of that name exists"));
   }
+  const fs::path file = folder_ / kLockName;
+  // Read-only: a descriptor open for writing would, among other things, keep the file system
+  // from being remounted read-only while the run holds the lock.
+  fd_ = ::open(file.c_str(), O_RDONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    const int err = errno;
+    if (created_) fs::remove(folder_, ec);  // still empty: the lock file is not there
+    throw OutputError(fmt::format("cannot lock output folder '{}': cannot open '{}': {}",
+                                  folder_.string(), file.string(), std::strerror(err)));
+  }
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    // The holder wrote its process id into the file; a missing one is only left out.
+    char text[32] = {};
+    const ssize_t n = ::pread(fd_, text, sizeof text - 1, 0);
+    const std::string pid = n > 0 ? fmt::format(" (process {})", std::string(text, n)) : "";
+    release();
+    if (err == EWOULDBLOCK) {
+      throw std::runtime_error(fmt::format(
+          "output folder '{}' is in use by another run{}: it holds the lock on '{}'; wait for it "
+          "to finish or write to another folder",
+          folder_.string(), pid, file.string()));
+    }
+    throw OutputError(fmt::format("cannot lock output folder '{}': flock on '{}': {}",
+                                  folder_.string(), file.string(), std::strerror(err)));
+  }
+  locked_ = true;
+  // The process id, for the message above. Writing it also finds an unwritable folder (read-only
+  // file system) at once, not after the first frame has been computed.
+  const std::string pid = std::to_string(static_cast<long>(::getpid()));
+  const int w = ::open(file.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+  if (w < 0 || ::write(w, pid.data(), pid.size()) != static_cast<ssize_t>(pid.size())) {
+    const int err = errno;
+    if (w >= 0) ::close(w);
+    release();
+    throw OutputError(fmt::format("cannot write to output folder '{}': '{}': {}", folder_.string(),
+                                  file.string(), std::strerror(err)));
+  }
+  ::close(w);
+}
+
+OutputLock::~OutputLock() {
+  release();
+}
+
+void OutputLock::release() noexcept {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  // A folder this lock created and nothing was written to is removed again: a run that fails
+  // before its first frame leaves no output. (Not without the lock: another run may own it.)
+  if (created_ && locked_) {
+    bool only_lock = true;
+    for (fs::directory_iterator it(folder_, ec), end; !ec && it != end; it.increment(ec)) {
+      if (it->path().filename() != kLockName) only_lock = false;
+    }
+    if (!ec && only_lock) {
+      fs::remove(folder_ / kLockName, ec);
+      fs::remove(folder_, ec);
+    }
+  }
+  if (fd_ >= 0) ::close(fd_);  // releases the flock
+  fd_ = -1;
 }
 
 void write_mesh_atomic(const std::filesystem::path& path, const std::vector<Vec3>& x,
                        const std::vector<Face>& faces, const std::string& format) {
-  write_file_atomic(path, [&](std::ostream& out) {
+  const auto body = [&](std::ostream& out) {
     if (format == "ply") {
       out << "ply\nformat binary_little_endian 1.0\n"
           << "element vertex " << x.size() << "\nproperty float x\nproperty float y\n"
@@ -101,11 +172,12 @@ void write_mesh_atomic(const std::filesystem::path& path, const std::vector<Vec3
       }
       out.write(s.data(), static_cast<std::streamsize>(s.size()));
     }
-  });
+  };
+  write_file_atomic(path, body, Durability::sync);
 }
 
 void write_state_atomic(const std::filesystem::path& path, const ClothState& state, int frame) {
-  write_file_atomic(path, [&](std::ostream& out) {
+  const auto body = [&](std::ostream& out) {
     out.write(kStateMagic, sizeof kStateMagic);
     put(out, static_cast<std::int64_t>(state.x.size()));
     put(out, static_cast<std::int64_t>(frame));
@@ -113,7 +185,8 @@ void write_state_atomic(const std::filesystem::path& path, const ClothState& sta
     put_vecs(out, state.x);
     put_vecs(out, state.v);
     put_vecs(out, state.dv);
-  });
+  };
+  write_file_atomic(path, body, Durability::sync);
 }
 
 ClothState read_state(const std::filesystem::path& path, int num_vertices, int& frame) {
@@ -202,12 +275,16 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
     throw input_error((opt.out / "manifest.json").string(), 0,
                       fmt::format("cannot resume at frame {}: no run to resume", opt.resume_at));
   }
-  std::error_code ec;
-  fs::create_directories(opt.out, ec);
-  if (ec || !fs::is_directory(opt.out)) {
-    throw std::runtime_error(fmt::format("cannot create output folder '{}': {}", opt.out.string(),
-                                         ec ? ec.message() : "not a folder"));
+  std::optional<OutputLock> own_lock;
+  if (opt.lock == nullptr) {
+    own_lock.emplace(opt.out);
+  } else if (opt.lock->folder() != opt.out) {
+    throw std::invalid_argument(
+        fmt::format("run_simulation: the lock is on '{}', the output is '{}'",
+                    opt.lock->folder().string(), opt.out.string()));
   }
+  std::error_code ec;
+  remove_temporaries(opt.out);
   const fs::path manifest_path = opt.out / "manifest.json";
   nlohmann::json manifest;
   int done = 0;
@@ -267,7 +344,7 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
       // The manifest commits the earlier frame first; the later files are then stale.
       manifest["complete_frames"] = done;
       manifest["state_file"] = state_file;
-      write_file_atomic(manifest_path, [&](std::ostream& o) { o << manifest.dump(1) << '\n'; });
+      write_manifest(manifest_path, manifest);
       for (int k = done + 1; k <= last; ++k) {
         fs::remove(opt.out / frame_name(k, ext), ec);
         fs::remove(opt.out / state_name(k), ec);
@@ -333,7 +410,7 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
     write_state_atomic(opt.out / sname, sim.state(), 0);
     manifest["complete_frames"] = 0;
     manifest["state_file"] = sname;
-    write_file_atomic(manifest_path, [&](std::ostream& o) { o << manifest.dump(1) << '\n'; });
+    write_manifest(manifest_path, manifest);
   }
   std::vector<FrameStats> out;
   while (sim.frame() < total) {
@@ -347,7 +424,7 @@ std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {
     manifest["frames"].push_back(to_json(fst));
     manifest["complete_frames"] = k;
     manifest["state_file"] = sname;
-    write_file_atomic(manifest_path, [&](std::ostream& o) { o << manifest.dump(1) << '\n'; });
+    write_manifest(manifest_path, manifest);
     const bool keep = (opt.keep_states > 0 && old_frame % opt.keep_states == 0) ||
                       old_frame == opt.resume_at;    // the kept state a replay started from
     if (!keep) fs::remove(opt.out / old_state, ec);  // the manifest no longer points at it

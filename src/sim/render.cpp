@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
 #include <limits>
 
+#include "clothcd/core/atomic_file.hpp"
 #include "clothcd/core/error.hpp"
 
 namespace clothcd::sim {
@@ -185,19 +185,7 @@ void write_png(const std::filesystem::path& path, const Image& img) {
   chunk(png, "IHDR", ihdr);
   chunk(png, "IDAT", z);
   chunk(png, "IEND", {});
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-    out.close();
-    if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw std::runtime_error(
-          fmt::format("cannot write '{}' (disk full or output not writable?)", path.string()));
-    }
-  }
-  std::filesystem::rename(tmp, path);
+  write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
 }
 
 }  // namespace clothcd::sim

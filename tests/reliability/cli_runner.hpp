@@ -2,16 +2,21 @@
 // Runs the built `clothcd` binary in a scratch folder and captures its exit code and output, for
 // tests of what the command line answers to bad input and of what it leaves on disk.
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
+
+extern char** environ;
 
 namespace clothcd::test {
 
@@ -52,9 +57,14 @@ class CliScratch {
   /// Runs `clothcd ARGS` with the scratch folder as working directory. `prefix` is shell code run
   /// first (e.g. a `ulimit`). Output goes to files outside the scratch folder's listing.
   CliResult run(const std::string& args, const std::string& prefix = "") const {
+    return run_shell(prefix + " '" CLOTHCD_CLI "' " + args);
+  }
+
+  /// Runs the shell command `command` in the scratch folder, capturing it like run().
+  CliResult run_shell(const std::string& command) const {
     const auto out = dir_.string() + ".stdout", err = dir_.string() + ".stderr";
-    const std::string cmd = "cd '" + dir_.string() + "' && " + prefix + " '" CLOTHCD_CLI "' " +
-                            args + " >'" + out + "' 2>'" + err + "'";
+    const std::string cmd =
+        "cd '" + dir_.string() + "' && " + command + " >'" + out + "' 2>'" + err + "'";
     const int status = std::system(cmd.c_str());
     CliResult r;
     if (WIFEXITED(status)) r.code = WEXITSTATUS(status);
@@ -74,6 +84,58 @@ class CliScratch {
     }
     std::sort(names.begin(), names.end());
     return names;
+  }
+
+  /// Starts `clothcd ARGS...` in the background in the scratch folder, with `env` ("NAME=value")
+  /// added to the environment; stdout and stderr go to files beside the folder.
+  [[nodiscard]] pid_t spawn(const std::vector<std::string>& args,
+                            const std::vector<std::string>& env = {}) const {
+    std::vector<std::string> argv_s{CLOTHCD_CLI};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<std::string> env_s = env;
+    for (char** e = environ; *e != nullptr; ++e)
+      env_s.emplace_back(*e);
+    std::vector<char*> argv, envp;
+    for (auto& a : argv_s)
+      argv.push_back(a.data());
+    for (auto& e : env_s)
+      envp.push_back(e.data());
+    argv.push_back(nullptr);
+    envp.push_back(nullptr);
+    const std::string out = dir_.string() + ".stdout", err = dir_.string() + ".stderr";
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      // Only async-signal-safe calls from here on.
+      const int o = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (::chdir(dir_.c_str()) != 0 || o < 0 || e < 0) ::_exit(126);
+      ::dup2(o, 1);
+      ::dup2(e, 2);
+      ::execve(argv[0], argv.data(), envp.data());
+      ::_exit(127);
+    }
+    return pid;
+  }
+
+  /// Waits for a spawned run to end; its exit status (128 + signal when killed) and output.
+  [[nodiscard]] CliResult wait(pid_t pid) const {
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    CliResult r;
+    if (WIFEXITED(status)) r.code = WEXITSTATUS(status);
+    if (WIFSIGNALED(status)) r.code = 128 + WTERMSIG(status);
+    r.out = slurp(dir_.string() + ".stdout");
+    r.err = slurp(dir_.string() + ".stderr");
+    return r;
+  }
+
+  /// Waits until a spawned run stops itself (SIGSTOP); false when it ended instead.
+  [[nodiscard]] static bool wait_stopped(pid_t pid) {
+    int status = 0;
+    while (::waitpid(pid, &status, WUNTRACED) < 0 && errno == EINTR) {
+    }
+    return WIFSTOPPED(status);
   }
 
   static std::string slurp(const std::filesystem::path& p) {

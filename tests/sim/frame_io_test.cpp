@@ -69,32 +69,37 @@ TEST(FrameIo, StateRoundTripIsExact) {
   }
 }
 
-TEST(FrameIo, AtomicWriteLeavesNoTemporaryAndReplacesWhole) {
+// The lock is flock(2) on a file of the folder: a second holder, even in the same process (another
+// open file description), is refused and names the holder, and the run refuses with it.
+TEST(FrameIo, OutputFolderTakesOneRunAtATime) {
   TempDir dir;
-  fs::create_directories(dir.path);
-  write_file_atomic(dir.path / "f.txt", [](std::ostream& o) { o << "first version, long"; });
-  write_file_atomic(dir.path / "f.txt", [](std::ostream& o) { o << "second"; });
-  EXPECT_EQ(slurp(dir.path / "f.txt"), "second");
-  EXPECT_FALSE(fs::exists(dir.path / "f.txt.tmp"));
-  // A folder that cannot be created: a clear runtime_error, nothing left behind.
-  EXPECT_THROW(write_file_atomic(dir.path / "missing" / "f.txt", [](std::ostream&) {}),
-               std::runtime_error);
-}
-
-TEST(FrameIo, DiskFullIsReported) {
-  if (!fs::exists("/dev/full")) GTEST_SKIP() << "/dev/full not available";
-  TempDir dir;
-  fs::create_directories(dir.path);
-  // The temporary file is a link to /dev/full, which fails every write like a full disk.
-  fs::create_symlink("/dev/full", dir.path / "f.txt.tmp");
-  try {
-    write_file_atomic(dir.path / "f.txt", [](std::ostream& o) { o << std::string(1 << 16, 'x'); });
-    FAIL() << "expected an error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("disk full"), std::string::npos) << e.what();
+  const fs::path out = dir.path / "out";
+  {
+    const OutputLock first(out);
+    EXPECT_TRUE(fs::is_directory(out));
+    try {
+      const OutputLock second(out);
+      ADD_FAILURE() << "a second lock on the folder was granted";
+    } catch (const std::runtime_error& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("in use by another run"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("process " + std::to_string(::getpid())), std::string::npos) << msg;
+      EXPECT_NE(msg.find((out / ".lock").string()), std::string::npos) << msg;
+    }
+    Simulation sim(test_scene());
+    RunOptions opt;
+    opt.out = out;
+    EXPECT_THROW((void)run_simulation(sim, opt), std::runtime_error);
+    opt.lock = &first;
+    opt.frames = 1;
+    EXPECT_EQ(run_simulation(sim, opt).size(), 1u);
   }
-  EXPECT_FALSE(fs::exists(dir.path / "f.txt"));
-  EXPECT_FALSE(fs::is_symlink(dir.path / "f.txt.tmp"));
+  // Released: the next run may take it, and the folder with its frames stays.
+  EXPECT_NO_THROW(OutputLock again(out));
+  EXPECT_TRUE(fs::exists(out / "frame_0001.obj"));
+  // A folder the lock created and nothing was written to is removed again.
+  { const OutputLock unused(dir.path / "unused"); }
+  EXPECT_FALSE(fs::exists(dir.path / "unused"));
 }
 
 TEST(FrameIo, ResumeMatchesStraightRunBitwise) {

@@ -1,8 +1,9 @@
 #pragma once
 /// @file
 /// Output of a simulation run: one mesh file per frame, the solver state of the last frame (for
-/// `--resume`) and a manifest JSON; every file is written to a temporary name and renamed, so a
-/// reader never sees a partial file.
+/// `--resume`) and a manifest JSON; every file goes through write_file_atomic
+/// (clothcd/core/atomic_file.hpp), so a reader never sees a partial file, and the manifest,
+/// written last for each frame, is the commit point a resume starts from.
 
 #include <filesystem>
 #include <functional>
@@ -10,15 +11,34 @@
 #include <string>
 #include <vector>
 
+#include "clothcd/core/atomic_file.hpp"
 #include "clothcd/sim/integrator.hpp"
 #include "clothcd/sim/simulation.hpp"
 
 namespace clothcd::sim {
 
-/// Writes `path` by calling `write` on a temporary file, checking every byte reached the disk,
-/// then renaming. Throws std::runtime_error naming the file (and "disk full?") on failure.
-void write_file_atomic(const std::filesystem::path& path,
-                       const std::function<void(std::ostream&)>& write);
+/// Exclusive use of a simulation's output folder for the object's life, so that two runs never
+/// write one folder: `FOLDER/.lock` is locked with flock(2), which the kernel releases when the
+/// process ends in any way (a killed run never blocks its resume). Creates the folder when
+/// missing, and removes it again on release when nothing but the lock file was put in it.
+/// Throws std::runtime_error naming the folder (and the holder's process id) when another process
+/// holds it, and OutputError with the reason when the folder cannot be created or the lock file
+/// opened or written (which finds a read-only folder before any work is done).
+class OutputLock {
+ public:
+  explicit OutputLock(std::filesystem::path folder);
+  ~OutputLock();
+  OutputLock(const OutputLock&) = delete;
+  OutputLock& operator=(const OutputLock&) = delete;
+  [[nodiscard]] const std::filesystem::path& folder() const { return folder_; }
+
+ private:
+  void release() noexcept;
+  std::filesystem::path folder_;
+  int fd_ = -1;
+  bool created_ = false;  ///< the folder did not exist before
+  bool locked_ = false;
+};
 
 /// Triangle mesh as OBJ (text, %.9g) or binary little-endian PLY (float32 positions).
 void write_mesh_atomic(const std::filesystem::path& path, const std::vector<Vec3>& x,
@@ -47,9 +67,14 @@ struct RunOptions {
   int resume_at = -1;
   /// Called after every frame (progress display); may be empty.
   std::function<void(const FrameStats&, int total_frames)> on_frame;
+  /// The caller's lock on `out` (taken early, say, to refuse before a slow setup); when null,
+  /// run_simulation locks `out` itself for the call.
+  const OutputLock* lock = nullptr;
 };
-/// Returns the frames simulated in this call. Throws InputError for a bad resume folder and
-/// std::runtime_error when the output cannot be written.
+/// Returns the frames simulated in this call. Throws InputError for a bad resume folder,
+/// std::runtime_error when another run holds the folder, and OutputError (a std::runtime_error)
+/// naming the file and the reason when the output cannot be written; the files of the last
+/// complete frame are then left as they were. Temporary files a killed run left are removed.
 std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& options);
 
 }  // namespace clothcd::sim

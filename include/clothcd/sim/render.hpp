@@ -36,8 +36,8 @@ struct Image {
 /// view or a non-positive size.
 [[nodiscard]] Image render(const std::vector<RenderMesh>& meshes, const RenderOptions& options);
 
-/// Writes `image` as a PNG (to a temporary name, then renamed). Throws std::runtime_error naming
-/// the file when it cannot be written.
+/// Writes `image` as a PNG through write_file_atomic (clothcd/core/atomic_file.hpp). Throws
+/// OutputError (a std::runtime_error) naming the file and the reason when it cannot be written.
 void write_png(const std::filesystem::path& path, const Image& image);
 
 }  // namespace clothcd::sim
