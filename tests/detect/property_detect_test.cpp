@@ -131,5 +131,41 @@ TEST(DetectProperty, NonFinitePositionsNameTheVertex) {
   }
 }
 
+// Regression: a NaN thickness made every BVH box NaN, so that two triangles passing through each
+// other gave no collision at all (and an infinite or negative one threw std::invalid_argument
+// from the first kernel reached). Bad thickness and toi tolerance are an InputError naming the
+// option, at construction and at set_options, for both detectors.
+TEST(DetectProperty, BadThicknessOrToiToleranceIsAnInputErrorNamingTheOption) {
+  const std::vector<Face> faces{{0, 1, 2}, {3, 4, 5}};
+  Positions a(6, 3);
+  a << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2, 0.2, 1, 1.2, 0.2, 1, 0.2, 1.2, 1;
+  Positions b = a;
+  b.col(2).tail(3).setConstant(-1);  // the second triangle passes through the first
+  const Topology topo(faces, 6);
+  ASSERT_GT(brute_force_detect(topo, a, b).ee.size(), 0u);
+  auto expect_option_error = [](auto&& call, const std::string& option) {
+    try {
+      call();
+      ADD_FAILURE() << "no InputError for " << option;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(option), std::string::npos) << e.what();
+    }
+  };
+  for (double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), -0.01}) {
+    SCOPED_TRACE("value " + std::to_string(bad));
+    for (int which = 0; which < 2; ++which) {
+      DetectOptions o;
+      (which == 0 ? o.thickness : o.toi_tolerance) = bad;
+      const std::string name = which == 0 ? "thickness" : "toi tolerance";
+      expect_option_error([&] { SelfDetector d(faces, 6, a, o); }, name);
+      expect_option_error([&] { PairDetector d(faces, 6, a, faces, 6, a, o); }, name);
+      SelfDetector det(faces, 6, a, {});
+      expect_option_error([&] { det.set_options(o); }, name);
+      expect_same(det.detect(a, b), brute_force_detect(topo, a, b), 1e-4);  // options unchanged
+    }
+  }
+}
+
 }  // namespace
 }  // namespace clothcd
