@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "clothcd/bvh/bvh.hpp"
+#include "core/checked_index.hpp"
 
 namespace clothcd {
 
@@ -95,7 +96,9 @@ void Bvh::compute_flags() {
   contour_vertices_.clear();
   std::vector<int> loop;
   for (int i = 0; i < nn; ++i) {
-    contour_offsets_[i] = static_cast<int>(contour_vertices_.size());
+    // The loops of all disk nodes together can outgrow the int offsets long before the face ids
+    // do (a node's loop is counted at every level above its faces).
+    contour_offsets_[i] = detail::checked_int(contour_vertices_.size(), "BVH contours");
     BvhNode& n = nodes_[i];
     if (n.is_leaf() || !n.connected()) continue;
     const int s = i;
@@ -154,7 +157,7 @@ void Bvh::compute_flags() {
     n.flags |= BvhNode::kDisk;
     contour_vertices_.insert(contour_vertices_.end(), loop.begin(), loop.end());
   }
-  contour_offsets_[nn] = static_cast<int>(contour_vertices_.size());
+  contour_offsets_[nn] = detail::checked_int(contour_vertices_.size(), "BVH contours");
 }
 
 }  // namespace clothcd

@@ -15,6 +15,7 @@
 #include "clothcd/ccd/proximity.hpp"
 #include "contour.hpp"
 #include "narrow.hpp"
+#include "options.hpp"
 #include "orphans.hpp"
 #include "positions.hpp"
 #include "traversal.hpp"
@@ -37,6 +38,7 @@ struct PairBuffer {
 
 // Options the detector cannot honour are refused before any work.
 void check_options(const DetectOptions& o) {
+  detail::check_common_options(o);
   if (!(o.reuse_distance >= 0) || !std::isfinite(o.reuse_distance)) {
     throw InputError(
         fmt::format("reuse distance must be finite and >= 0, got {}", o.reuse_distance));

@@ -10,6 +10,7 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/oracle.hpp"
 #include "narrow.hpp"
+#include "options.hpp"
 #include "positions.hpp"
 #include "traversal.hpp"
 
@@ -141,6 +142,7 @@ struct PairDetector::Impl {
   Impl(std::vector<Face> fa, int na, const Positions& ra, std::vector<Face> fb, int nb,
        const Positions& rb, const DetectOptions& o)
       : ta(std::move(fa), na), tb(std::move(fb), nb), opt(o) {
+    detail::check_common_options(o);
     detail::to_points(ra, na, "reference shape A", a0);
     detail::to_points(rb, nb, "reference shape B", b0);
     ba = Bvh(ta, a0, o.build);

@@ -11,6 +11,7 @@
 #include <deque>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "clothcd/bvh/bvh.hpp"
@@ -34,6 +35,10 @@ struct TraversalCounters {
   }
 };
 
+/// Pending tasks of one run. A self task leaves at most 2 tasks behind as it descends a level and
+/// a pair task 1, so a tree of depth D never needs more than 4 D + 1: the builds stay below 130
+/// levels (patch splits stop at depth 96, median splits halve), so 1024 leaves room. A deeper tree
+/// makes run() throw (every build type), never write past the stack.
 inline constexpr int kStackSize = 1024;
 
 /// Runs one task: `cull(node, counters)` decides self skips, `leaf(a, b)` receives overlapping
@@ -91,7 +96,11 @@ struct Traversal {
     while (top > 0) {
       const Task t = stack[--top];
       step(t, c, local, [&](const Task& s) {
-        if (top == kStackSize) throw std::runtime_error("BVH traversal stack overflow");
+        if (top == kStackSize) {
+          throw std::length_error("BVH traversal stack overflow: more than " +
+                                  std::to_string(kStackSize) +
+                                  " pending node pairs (a tree deeper than the builds make)");
+        }
         stack[top++] = s;
       });
     }
