@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# The project's test command. Installs what is missing, builds the Release tree and runs every
-# ctest suite in it (labels unit, data, slow, install, cli) plus the format check, printing the
-# wall time of each stage and how many tests ran and skipped.
-#   --full  also builds the benchmarks and a clang tree with AddressSanitizer +
-#           UndefinedBehaviorSanitizer, runs the unit tests again there and fuzzes each libFuzzer
-#           target for a fixed number of runs from a fixed seed (the same inputs every time).
+# The project's test command. Installs what is missing, builds the Release tree and runs its
+# ctest suites (labels unit, data, slow, install, cli) plus the format check, printing the wall
+# time of each stage and how many tests ran and skipped.
+#   --full  also runs the minutes-long property sweeps (label sweep), builds the benchmarks and a
+#           clang tree with AddressSanitizer + UndefinedBehaviorSanitizer, runs the unit tests
+#           again there and fuzzes each libFuzzer target for a fixed number of runs from a fixed
+#           seed (the same inputs every time).
 # Data-driven tests read CLOTHCD_DATA (default ../shared/data). Where CI is set, missing data and
 # any skipped test fail the run, so a green CI always means the data tests ran.
 set -euo pipefail
@@ -14,7 +15,7 @@ full=0
 for arg in "$@"; do
   case "$arg" in
     --full) full=1 ;;
-    -h | --help) sed -n '2,9p' "$0"; exit 0 ;;
+    -h | --help) sed -n '2,10p' "$0"; exit 0 ;;
     *) echo "test.sh: unknown argument '$arg' (expected --full)" >&2; exit 2 ;;
   esac
 done
@@ -69,9 +70,12 @@ cmake --build build/release -j "$jobs"
 cmake --build build/release --target format-check
 
 stage "Release tests"
-CLOTHCD_DATA=$data run_ctest --test-dir build/release
+CLOTHCD_DATA=$data run_ctest --test-dir build/release -LE sweep
 
 if [ "$full" = 1 ]; then
+  stage "Property sweeps (label sweep)"
+  CLOTHCD_DATA=$data run_ctest --test-dir build/release -L sweep
+
   stage "Sanitizer + fuzzer build (clang, ASan + UBSan)"
   # A tree configured with another compiler cannot switch in place.
   if [ -f build/asan/CMakeCache.txt ] && ! grep -q '^CMAKE_CXX_COMPILER:FILEPATH=.*clang' build/asan/CMakeCache.txt; then
