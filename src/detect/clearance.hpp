@@ -2,8 +2,8 @@
 // Clearances for sound cone culling with a contact distance R > 0 (docs/algorithms.md 1.6): a
 // lower bound, over the whole step, on how close a patch's features can come to the features they
 // do not touch. Every bound is a distance at t = 0 and at t = 1 and a Lipschitz constant of the
-// motion: a distance that is d0 at t = 0, d1 at t = 1 and changes at most at rate L is at least
-// (d0 + d1 - L) / 2 throughout.
+// relative motion: a distance that is d0 at t = 0, d1 at t = 1 and changes at most at rate L is
+// at least (d0 + d1 - L) / 2 throughout.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -32,14 +32,16 @@ template <class Vec>
 }
 
 /// Lower bound over the step of the distance from a linearly moving point p to a linearly moving
-/// segment [a, b]: the distance is 1-Lipschitz in p and moves by at most max(|da|, |db|) when
-/// the segment's ends move by da and db.
+/// segment [a, b]. Seen from p the segment's ends move linearly by da - dp and db - dp, and the
+/// distance from a fixed point to a segment changes by at most the larger end displacement, so
+/// only the relative motion counts (a patch moving rigidly keeps its clearances).
 template <class Vec>
 [[nodiscard]] double moving_point_segment_clearance(const Vec& p0, const Vec& p1, const Vec& a0,
                                                     const Vec& a1, const Vec& b0, const Vec& b1) {
   const double d0 = point_segment_distance(p0, a0, b0);
   const double d1 = point_segment_distance(p1, a1, b1);
-  const double rate = (p1 - p0).norm() + std::max((a1 - a0).norm(), (b1 - b0).norm());
+  const Vec dp = p1 - p0;
+  const double rate = std::max((a1 - a0 - dp).norm(), (b1 - b0 - dp).norm());
   return 0.5 * (d0 + d1 - rate);
 }
 
