@@ -5,14 +5,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <optional>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "body_pairs.hpp"
-#include "bvh_pairs.hpp"
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/ccd/queries.hpp"
@@ -111,10 +110,12 @@ struct ContactHandler::Impl {
   // (the same pairs, faster: multilayer-kick frame 90, the first pass took 96 ms on the frame-0
   // tree, 58 ms rebuilt).
   double self_fit = 0.0;
-  // Body: proximity and CCD through clothcd BVHs of both meshes (static, then swept boxes),
-  // rebuilt when the meshes have deformed far from their build shapes.
-  std::optional<Topology> body_topo;
-  detail::FittedTree cloth_tree, body_tree;
+  // Body: proximity and CCD through the two-mesh detector (cloth A, body B), its trees rebuilt
+  // when their boxes have loosened past their fit right after the last build (body_fit: 0 not
+  // yet measured; see FittedTree::loosened).
+  std::optional<PairDetector> body;
+  const Topology* body_topo = nullptr;
+  std::array<double, 2> body_fit{0.0, 0.0};
   std::vector<Contact> proximity;
   std::vector<ContactConstraint> constraints;  // see add_constraint()
   std::vector<ContactCoupling> couplings;      // see add_proximity()
@@ -144,20 +145,12 @@ struct ContactHandler::Impl {
   // separation) still counts, so a zone that keeps every pair apart but cannot restore the margin
   // (cloth held between two body points that move differently) is accepted.
   double sep_scale = 1.0;
-  bool body_swept = false;  // body BVH holds this substep's swept boxes
-  // Cloth-body feature pairs (body_pairs.hpp): designated faces, feature boxes, use flags.
-  std::vector<int> cloth_vertex_face, cloth_edge_face, body_vertex_face, body_edge_face;
-  detail::MeshBoxes cloth_boxes, body_boxes;
-  std::vector<std::uint8_t> vertex_use, edge_use, face_use;  // see set_scope()
-  // Restricted passes: cloth faces touching a vertex whose motion changed, and the cloth BVH
-  // nodes holding such a face (see set_scope()).
-  std::vector<std::uint8_t> face_flag, node_flag;
   // Per-substep scratch.
   std::span<const Vec3> x0, b0, b1;
   std::vector<Vec3> vb;
   std::span<const double> inv_mass;
   double h = 0.0;
-  Positions x0m;
+  Positions x0m, b0m, b1m;
 
   Impl(const ClothModel& m, const ContactOptions& o)
       : model(m), opt(o), links(m.num_vertices(), m.seam_links()) {}
@@ -432,59 +425,29 @@ struct ContactHandler::Impl {
   }
 
   void ensure_body(const SubstepContext& ctx) {
-    if (body_topo) return;
-    const int nb = static_cast<int>(ctx.body_t0.size());
-    body_topo.emplace(*ctx.body_faces, nb);
-    detail::designated_faces(model.topology(), cloth_vertex_face, cloth_edge_face);
-    detail::designated_faces(*body_topo, body_vertex_face, body_edge_face);
-    cloth_tree = detail::FittedTree(model.topology());  // built at the first refit
-    body_tree = detail::FittedTree(*body_topo);
+    if (body) return;
+    DetectOptions o;
+    o.thickness = opt.ccd_thickness;
+    o.toi_tolerance = kToiTolerance;
+    o.distance_filter_depth = kFilterDepth;
+    body.emplace(model.topology().faces(), model.num_vertices(), x0m, *ctx.body_faces,
+                 static_cast<int>(ctx.body_t0.size()), b0m, o);
+    body_topo = &body->topology_b();
   }
 
   [[nodiscard]] bool has_body(const SubstepContext& ctx) const {
     return opt.body && ctx.body_faces != nullptr && !ctx.body_t0.empty();
   }
 
-  // What a cloth-body query uses of the cloth (empty: all): in a restricted pass (`active`: the
-  // vertices whose motion changed) the active vertices, the edges touching one, the faces
-  // touching one (face_flag) and the BVH nodes holding such a face (node_flag); never an
-  // escaping vertex's features (their body pairs would hold it inside, see find_escapes()).
-  void set_scope(const std::vector<int>* active) {
-    const Topology& t = model.topology();
-    vertex_use.clear();
-    edge_use.clear();
-    face_use.clear();
-    face_flag.clear();
-    node_flag.clear();
-    if (active != nullptr) {
-      vertex_use.assign(t.num_vertices(), 0);
-      for (int i : *active)
-        vertex_use[i] = 1;
-      face_flag = t.faces_touching(vertex_use);
-      edge_use = t.edges_touching(vertex_use);
-      node_flag = cloth_tree.bvh().nodes_holding(face_flag);
-    }
-    if (escapes.empty()) return;
-    if (vertex_use.empty()) vertex_use.assign(t.num_vertices(), 1);
-    if (edge_use.empty()) edge_use.assign(t.num_edges(), 1);
-    face_use.assign(t.num_faces(), 1);
-    for (int v = 0; v < t.num_vertices(); ++v)
-      vertex_use[v] = vertex_use[v] && !escaping[v];
-    for (int e = 0; e < t.num_edges(); ++e) {
-      const Edge& d = t.edges()[e];
-      edge_use[e] = edge_use[e] && !escaping[d[0]] && !escaping[d[1]];
-    }
-    for (int f = 0; f < t.num_faces(); ++f)
-      face_use[f] = !touches_escaping(t.faces()[f]);
+  // An escaping vertex's body pairs would hold it inside (see find_escapes()): pairs with a
+  // cloth feature touching one are left out of the body's repulsion and CCD.
+  [[nodiscard]] bool escapes_vf(int cloth_vertex) const { return escaping[cloth_vertex] != 0; }
+  [[nodiscard]] bool escapes_fv(int cloth_face) const {
+    return touches_escaping(model.topology().faces()[cloth_face]);
   }
-
-  [[nodiscard]] detail::PairSide cloth_side() const {
-    return {&model.topology(), &cloth_tree.bvh(), &cloth_boxes, cloth_vertex_face,
-            cloth_edge_face,   vertex_use,        edge_use,     face_use};
-  }
-  [[nodiscard]] detail::PairSide body_side() const {
-    return {&*body_topo, &body_tree.bvh(), &body_boxes, body_vertex_face, body_edge_face, {}, {},
-            {}};
+  [[nodiscard]] bool escapes_ee(int cloth_edge) const {
+    const Edge& e = model.topology().edges()[cloth_edge];
+    return escaping[e[0]] || escaping[e[1]];
   }
 
   void prepare(const SubstepContext& ctx) {
@@ -498,8 +461,11 @@ struct ContactHandler::Impl {
     constraints.clear();
     couplings.clear();
     excluded = 0;
-    body_swept = false;
-    if (has_body(ctx)) ensure_body(ctx);  // the crossing counter and the body queries need it
+    if (has_body(ctx)) {
+      b0m = to_matrix(b0);
+      b1m = to_matrix(b1);
+      ensure_body(ctx);  // the crossing counter and the body queries need it
+    }
     find_crossings(ctx);
     find_escapes();
     const std::span<const Vec3> none;
@@ -533,72 +499,51 @@ struct ContactHandler::Impl {
         if (make_ee(c, p.edge_a, false, p.edge_b, false, 0.0, none)) add_proximity(c);
       }
     }
-    if (has_body(ctx)) {
-      RefitOptions ro;
-      ro.cones = false;
-      ro.thickness = dh;
-      cloth_tree.refit(x0, ro);
-      body_tree.refit(b0, ro);
-      const auto& cf = model.topology().faces();
-      const auto& bf = body_topo->faces();
-      const auto& ce = model.topology().edges();
-      const auto& be = body_topo->edges();
-      // Feature boxes within d-hat of each other prune most candidates of an overlapping face
-      // pair; an escaping vertex's body pairs would hold it inside (see find_escapes()).
-      set_scope(nullptr);
-      detail::fill_feature_boxes(model.topology(), x0, x0, vertex_use, edge_use, {}, cloth_boxes);
-      detail::fill_feature_boxes(*body_topo, b0, b0, {}, {}, {}, body_boxes);
-      // No feature pair of two faces is closer than the faces' bound.
-      const detail::BodyPairs pairs =
-          detail::close_feature_pairs(cloth_side(), body_side(), dh, {}, [&](int f, int g) {
-            const Face &a = cf[f], &b = bf[g];
-            return triangle_triangle_distance_lower_bound(x0[a[0]], x0[a[1]], x0[a[2]], b0[b[0]],
-                                                          b0[b[1]], b0[b[2]]) > dh;
-          });
-      const auto& vf_cb = pairs.vf_cb;
-      const auto& vf_bc = pairs.vf_bc;
-      const auto& ee = pairs.ee;
-      // Distances in parallel into flags; contacts are then built in the sorted order.
-      auto within = [&](const std::vector<std::pair<int, int>>& l, auto&& dist) {
-        std::vector<std::uint8_t> keep(l.size(), 0);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, l.size(), 512),
-                          [&](const tbb::blocked_range<std::size_t>& r) {
-                            for (std::size_t i = r.begin(); i != r.end(); ++i)
-                              keep[i] = dist(l[i].first, l[i].second) <= dh ? 1 : 0;
-                          });
-        return keep;
-      };
-      const auto k_cb = within(vf_cb, [&](int v, int g) {
-        const Face& t = bf[g];
-        return point_triangle_distance_if_within(x0[v], b0[t[0]], b0[t[1]], b0[t[2]], dh);
-      });
-      const auto k_bc = within(vf_bc, [&](int u, int f) {
-        const Face& t = cf[f];
-        return point_triangle_distance_if_within(b0[u], x0[t[0]], x0[t[1]], x0[t[2]], dh);
-      });
-      const auto k_ee = within(ee, [&](int a, int b) {
-        return edge_edge_distance_if_within(x0[ce[a][0]], x0[ce[a][1]], b0[be[b][0]], b0[be[b][1]],
-                                            dh);
-      });
-      for (std::size_t i = 0; i < vf_cb.size(); ++i) {
-        Contact c;
-        if (k_cb[i] && make_vf(c, vf_cb[i].first, false, vf_cb[i].second, true, 0.0, none)) {
-          proximity.push_back(c);
-          if (opt.body_constraints) add_constraint(c);
-        }
+    if (has_body(ctx)) body_proximity(dh);
+  }
+
+  // Cloth-body contacts within dh at the substep start, in the detector's sorted order: (cloth
+  // vertex, body face) pairs also give constraints, the others couplings.
+  void body_proximity(double dh) {
+    const std::span<const Vec3> none;
+    body->clear_active();
+    const PairProximityResult r = body->proximity(x0m, b0m, dh);
+    refit_body_trees();
+    for (const auto& p : r.vf_a_on_b) {
+      Contact c;
+      if (!escapes_vf(p.vertex) && make_vf(c, p.vertex, false, p.face, true, 0.0, none)) {
+        proximity.push_back(c);
+        if (opt.body_constraints) add_constraint(c);
       }
-      for (std::size_t i = 0; i < vf_bc.size(); ++i) {
-        Contact c;
-        if (k_bc[i] && make_vf(c, vf_bc[i].first, true, vf_bc[i].second, false, 0.0, none)) {
-          add_proximity(c);
-        }
+    }
+    for (const auto& p : r.vf_b_on_a) {
+      Contact c;
+      if (!escapes_fv(p.face) && make_vf(c, p.vertex, true, p.face, false, 0.0, none)) {
+        add_proximity(c);
       }
-      for (std::size_t i = 0; i < ee.size(); ++i) {
-        Contact c;
-        if (k_ee[i] && make_ee(c, ee[i].first, false, ee[i].second, true, 0.0, none)) {
-          add_proximity(c);
-        }
+    }
+    for (const auto& p : r.ee) {
+      Contact c;
+      if (!escapes_ee(p.edge_a) && make_ee(c, p.edge_a, false, p.edge_b, true, 0.0, none)) {
+        add_proximity(c);
       }
+    }
+  }
+
+  // The body detector's trees keep the splits of the shapes they were built on; once either's
+  // static boxes (just refit by the proximity query) have loosened past their fit after the last
+  // build, both are rebuilt on the substep start. Only the queries' time depends on it.
+  void refit_body_trees() {
+    const std::array<double, 2> ratio{body->bvh_a().box_area_ratio(),
+                                      body->bvh_b().box_area_ratio()};
+    if (body_fit[0] == 0.0) {
+      body_fit = ratio;
+      return;
+    }
+    if (detail::FittedTree::loosened(ratio[0], body_fit[0]) ||
+        detail::FittedTree::loosened(ratio[1], body_fit[1])) {
+      body->rebuild(x0m, b0m);
+      body_fit = {0.0, 0.0};
     }
   }
 
@@ -653,19 +598,23 @@ struct ContactHandler::Impl {
     Contact contact;
   };
 
-  // Seam-linked pairs are dropped; tangled pairs and pairs touching at t0 are excluded (left to
-  // repulsion); a resting pair, closer at t0 than twice the CCD separation, is retested at its
-  // own separation (see separation()); the rest become contacts at their time of impact.
+  // Dropped pairs (seam-linked, or an escaping vertex's body pairs) are dropped; tangled pairs
+  // and pairs touching at t0 are excluded (left to repulsion); a pair farther apart at t0 (d0())
+  // than `reach` (what both sides move plus the separation) cannot touch; a resting pair, closer
+  // at t0 than twice the CCD separation, is retested at its own separation (see separation());
+  // the rest become contacts at the detector's time of impact.
   template <class Query, class Distance, class Make>
-  SelfHit settle(bool linked, bool tangled, double toi, const Query& query, Distance&& d0,
-                 Make&& make) const {
+  SelfHit settle(bool dropped, bool tangled, double toi, const Query& query, Distance&& d0,
+                 Make&& make, double reach = std::numeric_limits<double>::infinity()) const {
     SelfHit r;
-    if (linked) return r;
+    if (dropped) return r;
     if (tangled) {
       r.fate = SelfHit::Excluded;
       return r;
     }
-    const double s = separation(d0());
+    const double d = d0();
+    if (d > reach) return r;
+    const double s = separation(d);
     if (s < 0) {
       r.fate = SelfHit::Excluded;
       return r;
@@ -738,145 +687,85 @@ struct ContactHandler::Impl {
               return make_ee(c, p.edge_a, false, p.edge_b, false, toi, v);
             });
       });
-      for (const auto* l : {&vf, &ee}) {
-        for (const SelfHit& hit : *l) {
-          if (hit.fate == SelfHit::Excluded) ++excluded;
-          if (hit.fate == SelfHit::Kept) out.push_back(hit.contact);
-        }
-      }
+      gather({&vf, &ee}, out);
     }
-    if (has_body(ctx)) {
-      body_hits(x1, v, active, out);
-    }
+    if (has_body(ctx)) body_hits(x1m, x1, v, active, out);
     return out;
   }
 
-  // Cloth-body CCD: swept BVHs of both meshes, feature pairs whose swept boxes overlap, a
-  // distance bound (a pair farther apart at t0 than both sides can move plus the separation
-  // cannot touch; resting contact is mostly this), then clothcd's conservative CCD kernels.
-  void body_hits(const std::vector<Vec3>& x1, std::span<const Vec3> v,
+  // Cloth-body CCD hits: the detector's hits at the full separation, each settled like a self
+  // hit. Its distance at t0 is measured within the reach of the pair's motion (a pair farther
+  // apart cannot touch), the measure the separation of a resting pair is taken from.
+  void body_hits(const Positions& x1m, std::span<const Vec3> x1, std::span<const Vec3> v,
                  const std::vector<int>* active, std::vector<Contact>& out) {
-    const double sep = opt.ccd_thickness;
-    RefitOptions ro;
-    ro.cones = false;
-    ro.thickness = sep;
-    // A later pass redoes only the nodes over moved vertices.
-    cloth_tree.bvh().refit_changed(x0, x1, ro);
-    const bool refit_body = !body_swept;  // the body's motion is fixed for the substep
-    if (refit_body) {
-      body_tree.bvh().refit(b0, b1, ro);
-      body_swept = true;
+    if (active != nullptr) {
+      body->set_active_vertices(*active);
+    } else {
+      body->clear_active();
     }
-    set_scope(active);
+    const PairDetectResult r = body->detect(x0m, x1m, b0m, b1m);
     const auto& cf = model.topology().faces();
     const auto& bf = body_topo->faces();
     const auto& ce = model.topology().edges();
     const auto& be = body_topo->edges();
-    std::vector<double> move_c(x0.size()), move_b(b0.size());
-    for (std::size_t i = 0; i < x0.size(); ++i)
-      move_c[i] = (x1[i] - x0[i]).norm();
-    for (std::size_t i = 0; i < b0.size(); ++i)
-      move_b[i] = (b1[i] - b0[i]).norm();
-    // Face boxes serve the body's vertices; a restricted pass visits the flagged faces only.
-    detail::fill_feature_boxes(model.topology(), x0, x1, vertex_use, edge_use, face_flag,
-                               cloth_boxes);
-    if (refit_body) detail::fill_feature_boxes(*body_topo, b0, b1, {}, {}, {}, body_boxes);
-    // Face pairs the distance filter culls whole at the full separation (each pair's own is at
-    // most that); not while some pairs cross, whose features' fate is counted as excluded.
-    detail::FacePairSkip apart;
-    if (crossing_body.empty()) {
-      apart = [&](int f, int g) {
-        const Face &a = cf[f], &b = bf[g];
-        return distance_filter_culls(
-            TriangleTriangleQuery{x0[a[0]], x0[a[1]], x0[a[2]], b0[b[0]], b0[b[1]], b0[b[2]],
-                                  x1[a[0]], x1[a[1]], x1[a[2]], b1[b[0]], b1[b[1]], b1[b[2]]},
-            sep);
-      };
-    }
-    const detail::BodyPairs pairs =
-        detail::close_feature_pairs(cloth_side(), body_side(), sep, node_flag, apart);
-    const auto& vf_cb = pairs.vf_cb;
-    const auto& vf_bc = pairs.vf_bc;
-    const auto& ee = pairs.ee;
-    // Each test gives (toi or -1 for none or -2 for tangled, separation used).
-    struct Outcome {
-      double toi = -1.0;
-      double sep = 0.0;
-    };
-    auto run = [&](const std::vector<std::pair<int, int>>& l, auto&& test) {
-      std::vector<Outcome> out(l.size());
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, l.size(), 256),
-                        [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t i = r.begin(); i != r.end(); ++i)
-                            out[i] = test(l[i].first, l[i].second);
-                        });
-      return out;
-    };
-    // A pair farther apart at t0 than both sides can move plus the separation cannot touch.
-    auto ccd = [&](double d0, double reach, const auto& q) {
-      if (d0 > reach) return Outcome{};
-      const double s = separation(d0);
-      if (s < 0) return Outcome{-2.0, 0.0};
-      if (distance_filter_culls(q, s, kFilterDepth)) return Outcome{};
-      const CcdResult r = kernel(q, ccd_options(s));
-      return Outcome{r.hit ? r.toi : -1.0, s};
-    };
-    const auto t_cb = run(vf_cb, [&](int i, int g) {
-      if (cloth_vertex_body_face_tangled(i, g)) return Outcome{-2.0, 0.0};
-      const Face& t = bf[g];
-      const double reach = move_c[i] + std::max({move_b[t[0]], move_b[t[1]], move_b[t[2]]}) + sep;
-      const double d0 =
-          point_triangle_distance_if_within(x0[i], b0[t[0]], b0[t[1]], b0[t[2]], reach);
-      return ccd(d0, reach,
-                 VertexFaceQuery{x0[i], b0[t[0]], b0[t[1]], b0[t[2]], x1[i], b1[t[0]], b1[t[1]],
-                                 b1[t[2]]});
+    const double sep = opt.ccd_thickness;
+    auto move_c = [&](int i) { return (x1[i] - x0[i]).norm(); };
+    auto move_b = [&](int i) { return (b1[i] - b0[i]).norm(); };
+    const std::vector<SelfHit> cb = map_parallel(r.vf_a_on_b.size(), [&](std::size_t k) {
+      const VertexFaceCollision& p = r.vf_a_on_b[k];
+      const int i = p.vertex;
+      const Face& t = bf[p.face];
+      const double reach = move_c(i) + std::max({move_b(t[0]), move_b(t[1]), move_b(t[2])}) + sep;
+      return settle(
+          escapes_vf(i), cloth_vertex_body_face_tangled(i, p.face), p.toi,
+          VertexFaceQuery{x0[i], b0[t[0]], b0[t[1]], b0[t[2]], x1[i], b1[t[0]], b1[t[1]], b1[t[2]]},
+          [&] {
+            return point_triangle_distance_if_within(x0[i], b0[t[0]], b0[t[1]], b0[t[2]], reach);
+          },
+          [&](Contact& c, double toi) { return make_vf(c, i, false, p.face, true, toi, v); },
+          reach);
     });
-    const auto t_bc = run(vf_bc, [&](int u, int f) {
-      if (body_vertex_cloth_face_tangled(u, f)) return Outcome{-2.0, 0.0};
-      const Face& t = cf[f];
-      const double reach = move_b[u] + std::max({move_c[t[0]], move_c[t[1]], move_c[t[2]]}) + sep;
-      const double d0 =
-          point_triangle_distance_if_within(b0[u], x0[t[0]], x0[t[1]], x0[t[2]], reach);
-      return ccd(d0, reach,
-                 VertexFaceQuery{b0[u], x0[t[0]], x0[t[1]], x0[t[2]], b1[u], x1[t[0]], x1[t[1]],
-                                 x1[t[2]]});
+    const std::vector<SelfHit> bc = map_parallel(r.vf_b_on_a.size(), [&](std::size_t k) {
+      const VertexFaceCollision& p = r.vf_b_on_a[k];
+      const int u = p.vertex;
+      const Face& t = cf[p.face];
+      const double reach = move_b(u) + std::max({move_c(t[0]), move_c(t[1]), move_c(t[2])}) + sep;
+      return settle(
+          escapes_fv(p.face), body_vertex_cloth_face_tangled(u, p.face), p.toi,
+          VertexFaceQuery{b0[u], x0[t[0]], x0[t[1]], x0[t[2]], b1[u], x1[t[0]], x1[t[1]], x1[t[2]]},
+          [&] {
+            return point_triangle_distance_if_within(b0[u], x0[t[0]], x0[t[1]], x0[t[2]], reach);
+          },
+          [&](Contact& c, double toi) { return make_vf(c, u, true, p.face, false, toi, v); },
+          reach);
     });
-    const auto t_ee = run(ee, [&](int a, int b) {
-      if (cloth_edge_body_edge_tangled(a, b)) return Outcome{-2.0, 0.0};
-      const Edge& x = ce[a];
-      const Edge& y = be[b];
+    const std::vector<SelfHit> ee = map_parallel(r.ee.size(), [&](std::size_t k) {
+      const EdgeEdgeCollision& p = r.ee[k];
+      const Edge& x = ce[p.edge_a];
+      const Edge& y = be[p.edge_b];
       const double reach =
-          std::max(move_c[x[0]], move_c[x[1]]) + std::max(move_b[y[0]], move_b[y[1]]) + sep;
-      const double d0 = edge_edge_distance_if_within(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], reach);
-      return ccd(d0, reach,
-                 EdgeEdgeQuery{x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], x1[x[0]], x1[x[1]], b1[y[0]],
-                               b1[y[1]]});
+          std::max(move_c(x[0]), move_c(x[1])) + std::max(move_b(y[0]), move_b(y[1])) + sep;
+      return settle(
+          escapes_ee(p.edge_a), cloth_edge_body_edge_tangled(p.edge_a, p.edge_b), p.toi,
+          EdgeEdgeQuery{x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], x1[x[0]], x1[x[1]], b1[y[0]],
+                        b1[y[1]]},
+          [&] {
+            return edge_edge_distance_if_within(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], reach);
+          },
+          [&](Contact& c, double toi) {
+            return make_ee(c, p.edge_a, false, p.edge_b, true, toi, v);
+          },
+          reach);
     });
-    for (const auto* t : {&t_cb, &t_bc, &t_ee}) {
-      excluded +=
-          std::count_if(t->begin(), t->end(), [](const Outcome& o) { return o.toi == -2.0; });
-    }
-    auto keep = [&](Contact& c, const Outcome& o, bool made) {
-      if (!made) return;
-      c.sep = o.sep;
-      out.push_back(c);
-    };
-    for (std::size_t i = 0; i < vf_cb.size(); ++i) {
-      Contact c;
-      if (t_cb[i].toi >= 0) {
-        keep(c, t_cb[i], make_vf(c, vf_cb[i].first, false, vf_cb[i].second, true, t_cb[i].toi, v));
-      }
-    }
-    for (std::size_t i = 0; i < vf_bc.size(); ++i) {
-      Contact c;
-      if (t_bc[i].toi >= 0) {
-        keep(c, t_bc[i], make_vf(c, vf_bc[i].first, true, vf_bc[i].second, false, t_bc[i].toi, v));
-      }
-    }
-    for (std::size_t i = 0; i < ee.size(); ++i) {
-      Contact c;
-      if (t_ee[i].toi >= 0) {
-        keep(c, t_ee[i], make_ee(c, ee[i].first, false, ee[i].second, true, t_ee[i].toi, v));
+    gather({&cb, &bc, &ee}, out);
+  }
+
+  // The kept contacts of settled hits in order; excluded ones are counted.
+  void gather(std::initializer_list<const std::vector<SelfHit>*> lists, std::vector<Contact>& out) {
+    for (const auto* l : lists) {
+      for (const SelfHit& hit : *l) {
+        if (hit.fate == SelfHit::Excluded) ++excluded;
+        if (hit.fate == SelfHit::Kept) out.push_back(hit.contact);
       }
     }
   }
