@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string_view>
 
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
@@ -309,10 +310,10 @@ struct PairDetector::Impl {
     detail::FeatureContext cb = detail::proximity_context(b.topo, b.x0, h);
     a.boxes.update(ca);
     b.boxes.update(cb);
-    const auto& fa_ = a.topo.faces();
-    const auto& fb_ = b.topo.faces();
-    const auto& ea_ = a.topo.edges();
-    const auto& eb_ = b.topo.edges();
+    const auto& faces_a = a.topo.faces();
+    const auto& faces_b = b.topo.faces();
+    const auto& edges_a = a.topo.edges();
+    const auto& edges_b = b.topo.edges();
     struct Found {
       std::vector<ProximityResult::VertexFace> ab, ba;
       std::vector<ProximityResult::EdgeEdge> ee;
@@ -328,26 +329,26 @@ struct PairDetector::Impl {
           for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const auto [f, g] = pairs[i];
             // No feature pair is closer than the whole triangles' bound.
-            if (detail::triangle_triangle_bound(detail::corners(xa, fa_[f]),
-                                                detail::corners(xb, fb_[g])) > h) {
+            if (detail::triangle_triangle_bound(detail::corners(xa, faces_a[f]),
+                                                detail::corners(xb, faces_b[g])) > h) {
               continue;
             }
             face_pair(
                 ca, cb, f, g, scope,
                 [&](int v, int k) {
-                  const Face& t = fb_[k];
+                  const Face& t = faces_b[k];
                   const double d =
                       point_triangle_distance_if_within(xa[v], xb[t[0]], xb[t[1]], xb[t[2]], h);
                   if (d <= h) out.ab.push_back({v, k, d});
                 },
                 [&](int u, int k) {
-                  const Face& t = fa_[k];
+                  const Face& t = faces_a[k];
                   const double d =
                       point_triangle_distance_if_within(xb[u], xa[t[0]], xa[t[1]], xa[t[2]], h);
                   if (d <= h) out.ba.push_back({u, k, d});
                 },
                 [&](int x, int y) {
-                  const Edge &p = ea_[x], &q = eb_[y];
+                  const Edge &p = edges_a[x], &q = edges_b[y];
                   const double d =
                       edge_edge_distance_if_within(xa[p[0]], xa[p[1]], xb[q[0]], xb[q[1]], h);
                   if (d <= h) out.ee.push_back({x, y, d});
