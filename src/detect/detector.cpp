@@ -218,17 +218,7 @@ struct SelfDetector::Impl {
   }
 
   [[nodiscard]] detail::FeatureContext ccd_context() const {
-    detail::FeatureContext ctx;
-    ctx.topo = &topo;
-    ctx.v0 = v0;
-    ctx.v1 = v1;
-    ctx.margin = 0.5 * opt.thickness;
-    ctx.np_filter = opt.np_filter;
-    ctx.ccd = CcdOptions{opt.thickness, opt.fast_path};
-    ctx.ccd.toi_tolerance = opt.toi_tolerance;
-    ctx.distance_depth = opt.distance_filter_depth;
-    ctx.links = links;
-    return ctx;
+    return detail::ccd_context(topo, v0, v1, opt, links);
   }
 
   // The feature pairs of `pairs` and of the orphans that collide (ctx's boxes are up to date).
@@ -407,11 +397,7 @@ struct SelfDetector::Impl {
     ro.thickness = h;
     ro.cones = false;  // cones carry no distance information (docs/algorithms.md 1.1)
     bvh.refit(v0, ro);
-    detail::FeatureContext ctx;
-    ctx.topo = &topo;
-    ctx.v0 = v0;
-    ctx.v1 = v1;
-    ctx.margin = 0.5 * h;
+    detail::FeatureContext ctx = detail::proximity_context(topo, v0, h);
     boxes.update(ctx);
     struct Buffer {
       std::vector<ProximityResult::VertexFace> vf;

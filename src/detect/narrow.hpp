@@ -140,17 +140,10 @@ struct FeatureContext {
   void kernel_vf(int v, int f, FeatureCounters& c, std::vector<VertexFaceCollision>& out) const {
     const Face& t = topo->faces()[f];
     if (grouped(v, t[0]) || grouped(v, t[1]) || grouped(v, t[2])) return;
-    ++c.vf_tests;
     const VertexFaceQuery q{v0[v], v0[t[0]], v0[t[1]], v0[t[2]],
                             v1[v], v1[t[0]], v1[t[1]], v1[t[2]]};
-    if ((separate_np() && np_filter_culls(q)) ||
-        (distance_filter() && distance_filter_culls(q, ccd.thickness, distance_depth))) {
-      ++c.vf_np;
-      return;
-    }
-    const CcdResult r = vertex_face_ccd(q, ccd);
-    c.vf_np += counted_np(r);
-    if (r.hit) out.push_back({v, f, t, r.toi});
+    double toi = 1.0;
+    if (ccd_hit(q, c.vf_tests, c.vf_np, toi)) out.push_back({v, f, t, toi});
   }
 
   /// Edges ea < eb (their boxes already overlap).
@@ -160,18 +153,31 @@ struct FeatureContext {
     if (grouped(a[0], b[0]) || grouped(a[0], b[1]) || grouped(a[1], b[0]) || grouped(a[1], b[1])) {
       return;
     }
-    ++c.ee_tests;
     const EdgeEdgeQuery q{v0[a[0]], v0[a[1]], v0[b[0]], v0[b[1]],
                           v1[a[0]], v1[a[1]], v1[b[0]], v1[b[1]]};
+    double toi = 1.0;
+    if (ccd_hit(q, c.ee_tests, c.ee_np, toi)) out.push_back({ea, eb, a, b, toi});
+  }
+
+  /// One feature query of any mesh or meshes through this context's filters and kernel: the NP
+  /// filter or the distance filter (whichever the settings use), then the kernel. Counts the
+  /// test in `tests` and a filter's cull in `culled`; on a hit sets `toi`.
+  template <class Query>
+  bool ccd_hit(const Query& q, std::uint64_t& tests, std::uint64_t& culled, double& toi) const {
+    ++tests;
     if ((separate_np() && np_filter_culls(q)) ||
         (distance_filter() && distance_filter_culls(q, ccd.thickness, distance_depth))) {
-      ++c.ee_np;
-      return;
+      ++culled;
+      return false;
     }
-    const CcdResult r = edge_edge_ccd(q, ccd);
-    c.ee_np += counted_np(r);
-    if (r.hit) out.push_back({ea, eb, a, b, r.toi});
+    const CcdResult r = ccd_kernel(q, ccd);
+    culled += counted_np(r);
+    if (r.hit) toi = r.toi;
+    return r.hit;
   }
+
+  /// Whether the distance filter is the one in use (thickness > 0, filters on).
+  [[nodiscard]] bool distance_filter() const { return np_filter && ccd.thickness > 0; }
 
  private:
   // With the fast path on, the kernel starts with the same NP filter (one cubic, computed once);
@@ -180,8 +186,13 @@ struct FeatureContext {
     return np_filter && ccd.thickness == 0 && !ccd.fast_path;
   }
   // With a thickness the cubic filter does not apply; the distance bound takes its place (it
-  // culls resting contact, the bulk of a simulator's pairs).
-  [[nodiscard]] bool distance_filter() const { return np_filter && ccd.thickness > 0; }
+  // culls resting contact, the bulk of a simulator's pairs): see distance_filter().
+  static CcdResult ccd_kernel(const VertexFaceQuery& q, const CcdOptions& o) {
+    return vertex_face_ccd(q, o);
+  }
+  static CcdResult ccd_kernel(const EdgeEdgeQuery& q, const CcdOptions& o) {
+    return edge_edge_ccd(q, o);
+  }
   [[nodiscard]] bool counted_np(const CcdResult& r) const {
     return np_filter && r.path == CcdPath::np_culled;
   }
@@ -203,6 +214,36 @@ inline std::vector<std::pair<int, int>> sorted_links(const std::vector<std::pair
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
+}
+
+/// The context of a CCD step under `options` (thickness, filters, kernel settings; linked
+/// vertices already normalized by sorted_links, or empty): the one place the options become
+/// kernel settings, for the self and the two-mesh detectors and their oracles.
+inline FeatureContext ccd_context(const Topology& topo, std::span<const Eigen::Vector3d> v0,
+                                  std::span<const Eigen::Vector3d> v1, const DetectOptions& options,
+                                  std::span<const std::pair<int, int>> links = {}) {
+  FeatureContext ctx;
+  ctx.topo = &topo;
+  ctx.v0 = v0;
+  ctx.v1 = v1;
+  ctx.margin = 0.5 * options.thickness;
+  ctx.np_filter = options.np_filter;
+  ctx.ccd = CcdOptions{options.thickness, options.fast_path};
+  ctx.ccd.toi_tolerance = options.toi_tolerance;
+  ctx.distance_depth = options.distance_filter_depth;
+  ctx.links = links;
+  return ctx;
+}
+
+/// The context of a proximity query at distance h at positions v (boxes only: no kernel runs).
+inline FeatureContext proximity_context(const Topology& topo, std::span<const Eigen::Vector3d> v,
+                                        double h) {
+  FeatureContext ctx;
+  ctx.topo = &topo;
+  ctx.v0 = v;
+  ctx.v1 = v;
+  ctx.margin = 0.5 * h;
+  return ctx;
 }
 
 /// The swept boxes of every vertex, edge and face for one step, kept between steps: `update`

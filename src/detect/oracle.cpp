@@ -19,21 +19,6 @@ struct Buffer {
   std::vector<EdgeEdgeCollision> ee;
 };
 
-detail::FeatureContext make_context(const Topology& topo, const std::vector<Eigen::Vector3d>& v0,
-                                    const std::vector<Eigen::Vector3d>& v1,
-                                    const DetectOptions& o) {
-  detail::FeatureContext ctx;
-  ctx.topo = &topo;
-  ctx.v0 = v0;
-  ctx.v1 = v1;
-  ctx.margin = 0.5 * o.thickness;
-  ctx.np_filter = o.np_filter;
-  ctx.ccd = CcdOptions{o.thickness, o.fast_path};
-  ctx.ccd.toi_tolerance = o.toi_tolerance;
-  ctx.distance_depth = o.distance_filter_depth;
-  return ctx;
-}
-
 }  // namespace
 
 DetectResult brute_force_detect(const Topology& topo, const Positions& p0, const Positions& p1,
@@ -43,8 +28,7 @@ DetectResult brute_force_detect(const Topology& topo, const Positions& p0, const
   detail::to_points(p0, topo.num_vertices(), "positions at t0", v0);
   detail::to_points(p1, topo.num_vertices(), "positions at t1", v1);
   const auto links = detail::sorted_links(options.linked_vertices, topo.num_vertices());
-  detail::FeatureContext ctx = make_context(topo, v0, v1, options);
-  ctx.links = links;
+  const detail::FeatureContext ctx = detail::ccd_context(topo, v0, v1, options, links);
   const bool restricted = !active.empty();
   std::vector<std::uint8_t> vact(topo.num_vertices(), 0), eact(topo.num_edges(), 0);
   for (int f = 0; f < topo.num_faces() && restricted; ++f) {

@@ -1,12 +1,16 @@
 // Inter-object detection between two meshes (garment against body): pair traversal of the two
-// BVHs, then each VF / EE feature pair tested once, at the pair of the features' first faces.
+// BVHs, then each VF / EE feature pair tested once, at the pair of the features' first faces,
+// through the same feature boxes, filters and kernels as the self detector (narrow.hpp).
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <string_view>
 
+#include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/oracle.hpp"
 #include "narrow.hpp"
@@ -18,11 +22,93 @@ namespace clothcd {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
+// Options the two-mesh detector cannot honour are refused before any work.
+void check_pair_options(const DetectOptions& o) {
+  if (o.culling != Culling::None) {
+    throw InputError(
+        "PairDetector: normal cones cull self-collision tests only; use Culling::None between "
+        "two meshes");
+  }
+  if (o.verify) {
+    throw InputError(
+        "PairDetector: verify compares culled and unculled self traversals; it has "
+        "nothing to verify between two meshes");
+  }
+  if (o.reuse_distance != 0.0) {
+    throw InputError(fmt::format("PairDetector: reuse_distance is not supported (got {}); use 0",
+                                 o.reuse_distance));
+  }
+  if (!o.linked_vertices.empty()) {
+    throw InputError(
+        "PairDetector: linked_vertices join vertices of one mesh; no pair between "
+        "two meshes can hold two of them");
+  }
+  detail::check_common_options(o);
+}
+
+// One mesh: its topology, tree, swept boxes, positions of the current call, active restriction.
 struct Side {
-  const Topology* topo;
-  std::span<const Eigen::Vector3d> v0, v1;
+  Topology topo;
+  Bvh bvh;
+  detail::FeatureBoxes boxes;
+  std::vector<Eigen::Vector3d> x0, x1;
+  // Active vertices, the edges and faces touching one, and the nodes holding such a face.
+  std::vector<std::uint8_t> vertex_active, edge_active, face_active, node_active;
+
+  Side(std::vector<Face> faces, int nv, const Positions& ref, std::string_view name, BvhBuild build)
+      : topo(std::move(faces), nv) {
+    detail::to_points(ref, nv, name, x0);
+    bvh = Bvh::boxes_only(topo, x0, build);  // no cones: they cannot cull between two meshes
+  }
+
+  void set_active(std::span<const int> vertices, std::string_view mesh) {
+    const int nv = topo.num_vertices();
+    vertex_active.assign(nv, 0);
+    for (int v : vertices) {
+      if (v < 0 || v >= nv) {
+        throw InputError(
+            fmt::format("active vertex {} of mesh {} is out of range [0, {})", v, mesh, nv));
+      }
+      vertex_active[v] = 1;
+    }
+    face_active = topo.faces_touching(vertex_active);
+    edge_active = topo.edges_touching(vertex_active);
+    node_active = bvh.nodes_holding(face_active);
+  }
 };
+
+// The feature pairs of one leaf pair (fa, fb) that it represents (their features' first faces
+// are fa and fb) and that the scope keeps, past the feature box test: vf(v, f) with a vertex of
+// A and a face of B, fv(u, f) with a vertex of B and a face of A, ee(a, b).
+template <class InScope, class Vf, class Fv, class Ee>
+void face_pair(const detail::FeatureContext& ca, const detail::FeatureContext& cb, int fa, int fb,
+               InScope&& in_scope, Vf&& vf, Fv&& fv, Ee&& ee) {
+  const Topology& ta = *ca.topo;
+  const Topology& tb = *cb.topo;
+  const detail::Box& box_a = ca.fboxes[fa];
+  const detail::Box& box_b = cb.fboxes[fb];
+  for (int v : ta.faces()[fa]) {
+    if (ta.vertex_faces(v)[0] != fa || !detail::overlap(ca.vboxes[v], box_b)) continue;
+    if (in_scope.vf(v, fb)) vf(v, fb);
+  }
+  for (int u : tb.faces()[fb]) {
+    if (tb.vertex_faces(u)[0] != fb || !detail::overlap(cb.vboxes[u], box_a)) continue;
+    if (in_scope.fv(u, fa)) fv(u, fa);
+  }
+  for (int ea : ta.face_edges(fa)) {
+    if (ta.edge_faces(ea)[0] != fa) continue;
+    const detail::Box& xa = ca.eboxes[ea];
+    if (!detail::overlap(xa, box_b)) continue;  // the edge misses all of fb
+    for (int eb : tb.face_edges(fb)) {
+      if (tb.edge_faces(eb)[0] != fb || !detail::overlap(xa, cb.eboxes[eb])) continue;
+      if (in_scope.ee(ea, eb)) ee(ea, eb);
+    }
+  }
+}
 
 struct Buffer {
   detail::FeatureCounters c;
@@ -30,123 +116,253 @@ struct Buffer {
   std::vector<EdgeEdgeCollision> ee;
 };
 
-struct PairKernels {
-  Side a, b;
-  double margin;
-  bool np;
-  CcdOptions ccd;
-
-  detail::Box vbox(const Side& s, int v) const {
-    return detail::swept_box({&s.v0[v], &s.v1[v]}, margin);
-  }
-  detail::Box fbox(const Side& s, int f) const {
-    const Face& t = s.topo->faces()[f];
-    return detail::swept_box(
-        {&s.v0[t[0]], &s.v0[t[1]], &s.v0[t[2]], &s.v1[t[0]], &s.v1[t[1]], &s.v1[t[2]]}, margin);
-  }
-  detail::Box ebox(const Side& s, int e) const {
-    const Edge& d = s.topo->edges()[e];
-    return detail::swept_box({&s.v0[d[0]], &s.v0[d[1]], &s.v1[d[0]], &s.v1[d[1]]}, margin);
-  }
-  void vf(const Side& sv, int v, const Side& sf, int f, Buffer& out,
-          std::vector<VertexFaceCollision>& dst) const {
-    ++out.c.vf_tests;
-    const Face& t = sf.topo->faces()[f];
-    const VertexFaceQuery q{sv.v0[v], sf.v0[t[0]], sf.v0[t[1]], sf.v0[t[2]],
-                            sv.v1[v], sf.v1[t[0]], sf.v1[t[1]], sf.v1[t[2]]};
-    if (np && ccd.thickness == 0 && np_filter_culls(q)) {
-      ++out.c.vf_np;
-      return;
-    }
-    const CcdResult r = vertex_face_ccd(q, ccd);
-    if (r.hit) dst.push_back({v, f, t, r.toi});
-  }
-  void ee(int ea, int eb, Buffer& out) const {
-    ++out.c.ee_tests;
-    const Edge& x = a.topo->edges()[ea];
-    const Edge& y = b.topo->edges()[eb];
-    const EdgeEdgeQuery q{a.v0[x[0]], a.v0[x[1]], b.v0[y[0]], b.v0[y[1]],
-                          a.v1[x[0]], a.v1[x[1]], b.v1[y[0]], b.v1[y[1]]};
-    if (np && ccd.thickness == 0 && np_filter_culls(q)) {
-      ++out.c.ee_np;
-      return;
-    }
-    const CcdResult r = edge_edge_ccd(q, ccd);
-    if (r.hit) out.ee.push_back({ea, eb, x, y, r.toi});
-  }
-  // Feature pairs of faces (fa, fb) whose first faces they are; `all` skips that rule (oracle).
-  void face_pair(int fa, int fb, Buffer& out, bool all) const {
-    const detail::Box ba = fbox(a, fa), bb = fbox(b, fb);
-    for (int v : a.topo->faces()[fa]) {
-      if ((all || a.topo->vertex_faces(v)[0] == fa) && detail::overlap(vbox(a, v), bb)) {
-        vf(a, v, b, fb, out, out.ab);
-      }
-    }
-    for (int v : b.topo->faces()[fb]) {
-      if ((all || b.topo->vertex_faces(v)[0] == fb) && detail::overlap(vbox(b, v), ba)) {
-        vf(b, v, a, fa, out, out.ba);
-      }
-    }
-    for (int ea : a.topo->face_edges(fa)) {
-      if (!all && a.topo->edge_faces(ea)[0] != fa) continue;
-      const detail::Box xa = ebox(a, ea);
-      for (int eb : b.topo->face_edges(fb)) {
-        if (!all && b.topo->edge_faces(eb)[0] != fb) continue;
-        if (detail::overlap(xa, ebox(b, eb))) ee(ea, eb, out);
-      }
-    }
-  }
-};
-
-template <class T, class Less>
-void sort_unique(std::vector<T>& v, Less less) {
-  std::sort(v.begin(), v.end(), less);
-  v.erase(std::unique(v.begin(), v.end(),
-                      [&](const T& x, const T& y) { return !less(x, y) && !less(y, x); }),
-          v.end());
+// CCD of vertex v of side `sv` against face f of side `sf`, with the context `k`'s settings.
+bool vf_hit(const detail::FeatureContext& k, const detail::FeatureContext& sv, int v,
+            const detail::FeatureContext& sf, int f, detail::FeatureCounters& c, double& toi) {
+  const Face& t = sf.topo->faces()[f];
+  const VertexFaceQuery q{sv.v0[v], sf.v0[t[0]], sf.v0[t[1]], sf.v0[t[2]],
+                          sv.v1[v], sf.v1[t[0]], sf.v1[t[1]], sf.v1[t[2]]};
+  return k.ccd_hit(q, c.vf_tests, c.vf_np, toi);
 }
 
-PairDetectResult collect(tbb::enumerable_thread_specific<Buffer>& locals, bool dedupe) {
+bool ee_hit(const detail::FeatureContext& ca, int ea, const detail::FeatureContext& cb, int eb,
+            detail::FeatureCounters& c, double& toi) {
+  const Edge& x = ca.topo->edges()[ea];
+  const Edge& y = cb.topo->edges()[eb];
+  const EdgeEdgeQuery q{ca.v0[x[0]], ca.v0[x[1]], cb.v0[y[0]], cb.v0[y[1]],
+                        ca.v1[x[0]], ca.v1[x[1]], cb.v1[y[0]], cb.v1[y[1]]};
+  return ca.ccd_hit(q, c.ee_tests, c.ee_np, toi);
+}
+
+PairDetectResult collect(tbb::enumerable_thread_specific<Buffer>& locals) {
   PairDetectResult res;
   for (const auto& l : locals) {
     res.stats.vf_tests += l.c.vf_tests;
     res.stats.ee_tests += l.c.ee_tests;
     res.stats.vf_np_culled += l.c.vf_np;
     res.stats.ee_np_culled += l.c.ee_np;
+    res.stats.triangle_pairs_apart += l.c.faces_apart;
     res.vf_a_on_b.insert(res.vf_a_on_b.end(), l.ab.begin(), l.ab.end());
     res.vf_b_on_a.insert(res.vf_b_on_a.end(), l.ba.begin(), l.ba.end());
     res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
   }
-  if (dedupe) {
-    sort_unique(res.vf_a_on_b, detail::vf_less);
-    sort_unique(res.vf_b_on_a, detail::vf_less);
-    sort_unique(res.ee, detail::ee_less);
-  } else {
-    std::sort(res.vf_a_on_b.begin(), res.vf_a_on_b.end(), detail::vf_less);
-    std::sort(res.vf_b_on_a.begin(), res.vf_b_on_a.end(), detail::vf_less);
-    std::sort(res.ee.begin(), res.ee.end(), detail::ee_less);
-  }
+  std::sort(res.vf_a_on_b.begin(), res.vf_a_on_b.end(), detail::vf_less);
+  std::sort(res.vf_b_on_a.begin(), res.vf_b_on_a.end(), detail::vf_less);
+  std::sort(res.ee.begin(), res.ee.end(), detail::ee_less);
   res.stats.vf_collisions = res.vf_a_on_b.size() + res.vf_b_on_a.size();
   res.stats.ee_collisions = res.ee.size();
   return res;
 }
 
+template <class Item>
+void sort_by_ids(std::vector<Item>& v) {
+  std::sort(v.begin(), v.end(), [](const Item& x, const Item& y) {
+    if constexpr (requires { x.vertex; }) {
+      return std::pair(x.vertex, x.face) < std::pair(y.vertex, y.face);
+    } else {
+      return std::pair(x.edge_a, x.edge_b) < std::pair(y.edge_a, y.edge_b);
+    }
+  });
+}
+
 }  // namespace
 
 struct PairDetector::Impl {
-  Topology ta, tb;
   DetectOptions opt;
-  Bvh ba, bb;
-  std::vector<Eigen::Vector3d> a0, a1, b0, b1;
+  Side a, b;
+  bool restricted = false;
 
   Impl(std::vector<Face> fa, int na, const Positions& ra, std::vector<Face> fb, int nb,
        const Positions& rb, const DetectOptions& o)
-      : ta(std::move(fa), na), tb(std::move(fb), nb), opt(o) {
-    detail::check_common_options(o);
-    detail::to_points(ra, na, "reference shape A", a0);
-    detail::to_points(rb, nb, "reference shape B", b0);
-    ba = Bvh(ta, a0, o.build);
-    bb = Bvh(tb, b0, o.build);
+      : opt((check_pair_options(o), o)),
+        a(std::move(fa), na, ra, "reference shape A", o.build),
+        b(std::move(fb), nb, rb, "reference shape B", o.build) {}
+
+  // The active restriction: a VF pair when its vertex or a vertex of its face is active, an EE
+  // pair when an endpoint is active (SelfDetector::set_active_vertices across two meshes).
+  struct Scope {
+    const Impl& m;
+    [[nodiscard]] bool vf(int v, int f) const {
+      return !m.restricted || m.a.vertex_active[v] != 0 || m.b.face_active[f] != 0;
+    }
+    [[nodiscard]] bool fv(int u, int f) const {
+      return !m.restricted || m.b.vertex_active[u] != 0 || m.a.face_active[f] != 0;
+    }
+    [[nodiscard]] bool ee(int ea, int eb) const {
+      return !m.restricted || m.a.edge_active[ea] != 0 || m.b.edge_active[eb] != 0;
+    }
+  };
+
+  // Overlapping leaf pairs (face of A, face of B), below active nodes when restricted.
+  std::vector<std::pair<int, int>> traverse(DetectStats& st) const {
+    struct Pairs {
+      std::vector<std::pair<int, int>> v;
+    };
+    std::vector<std::pair<int, int>> pairs;
+    const auto& na = a.bvh.nodes();
+    const auto& nb = b.bvh.nodes();
+    if (na.empty() || nb.empty()) return pairs;
+    const auto& pa = a.bvh.prim_ids();
+    const auto& pb = b.bvh.prim_ids();
+    std::span<const std::uint8_t> act_a, act_b;
+    if (restricted) {
+      act_a = a.node_active;
+      act_b = b.node_active;
+    }
+    auto tr = detail::make_traversal(
+        std::span<const BvhNode>(na), std::span<const BvhNode>(nb), act_a, act_b,
+        [](int, detail::TraversalCounters&) { return false; },
+        [&](int x, int y, Pairs& out) { out.v.emplace_back(pa[na[x].first], pb[nb[y].first]); });
+    tbb::enumerable_thread_specific<Pairs> locals;
+    st.box_tests = detail::run_parallel(tr, {0, 0, false}, locals).box_tests;
+    for (const auto& l : locals)
+      pairs.insert(pairs.end(), l.v.begin(), l.v.end());
+    return pairs;
+  }
+
+  PairDetectResult detect(const Positions& a_t0, const Positions& a_t1, const Positions& b_t0,
+                          const Positions& b_t1) {
+    detail::to_points(a_t0, a.topo.num_vertices(), "mesh A at t0", a.x0);
+    detail::to_points(a_t1, a.topo.num_vertices(), "mesh A at t1", a.x1);
+    detail::to_points(b_t0, b.topo.num_vertices(), "mesh B at t0", b.x0);
+    detail::to_points(b_t1, b.topo.num_vertices(), "mesh B at t1", b.x1);
+    auto t = Clock::now();
+    RefitOptions ro;
+    ro.thickness = opt.thickness;
+    ro.cones = false;
+    a.bvh.refit_changed(a.x0, a.x1, ro);
+    b.bvh.refit_changed(b.x0, b.x1, ro);
+    const double t_refit = seconds_since(t);
+
+    t = Clock::now();
+    DetectStats st;
+    const auto pairs = traverse(st);
+    const double t_trav = seconds_since(t);
+
+    t = Clock::now();
+    detail::FeatureContext ca = detail::ccd_context(a.topo, a.x0, a.x1, opt);
+    detail::FeatureContext cb = detail::ccd_context(b.topo, b.x0, b.x1, opt);
+    a.boxes.update(ca);
+    b.boxes.update(cb);
+    tbb::enumerable_thread_specific<Buffer> locals;
+    const Scope scope{*this};
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          Buffer& out = locals.local();
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const auto [fa, fb] = pairs[i];
+            // The distance filter on whole triangles first: where it culls, it culls each of
+            // their feature pairs.
+            if (ca.distance_filter() &&
+                detail::triangles_filter_culls(detail::corners(a.x0, a.topo.faces()[fa]),
+                                               detail::corners(a.x1, a.topo.faces()[fa]),
+                                               detail::corners(b.x0, b.topo.faces()[fb]),
+                                               detail::corners(b.x1, b.topo.faces()[fb]),
+                                               opt.thickness)) {
+              ++out.c.faces_apart;
+              continue;
+            }
+            double toi = 1.0;
+            face_pair(
+                ca, cb, fa, fb, scope,
+                [&](int v, int f) {
+                  if (vf_hit(ca, ca, v, cb, f, out.c, toi))
+                    out.ab.push_back({v, f, b.topo.faces()[f], toi});
+                },
+                [&](int u, int f) {
+                  if (vf_hit(ca, cb, u, ca, f, out.c, toi))
+                    out.ba.push_back({u, f, a.topo.faces()[f], toi});
+                },
+                [&](int ea, int eb) {
+                  if (ee_hit(ca, ea, cb, eb, out.c, toi))
+                    out.ee.push_back({ea, eb, a.topo.edges()[ea], b.topo.edges()[eb], toi});
+                });
+          }
+        });
+    PairDetectResult res = collect(locals);
+    res.stats.box_tests = st.box_tests;
+    res.stats.triangle_pairs = pairs.size();
+    res.stats.time_refit = t_refit;
+    res.stats.time_traverse = t_trav;
+    res.stats.time_narrow = seconds_since(t);
+    return res;
+  }
+
+  PairProximityResult proximity(const Positions& pa, const Positions& pb, double h) {
+    if (!(h >= 0) || !std::isfinite(h)) {
+      throw InputError(fmt::format("proximity distance must be finite and >= 0, got {}", h));
+    }
+    detail::to_points(pa, a.topo.num_vertices(), "mesh A positions", a.x0);
+    detail::to_points(pb, b.topo.num_vertices(), "mesh B positions", b.x0);
+    a.x1 = a.x0;
+    b.x1 = b.x0;
+    RefitOptions ro;
+    ro.thickness = h;
+    ro.cones = false;
+    a.bvh.refit(a.x0, ro);
+    b.bvh.refit(b.x0, ro);
+    DetectStats st;
+    const auto pairs = traverse(st);
+    detail::FeatureContext ca = detail::proximity_context(a.topo, a.x0, h);
+    detail::FeatureContext cb = detail::proximity_context(b.topo, b.x0, h);
+    a.boxes.update(ca);
+    b.boxes.update(cb);
+    const auto& faces_a = a.topo.faces();
+    const auto& faces_b = b.topo.faces();
+    const auto& edges_a = a.topo.edges();
+    const auto& edges_b = b.topo.edges();
+    struct Found {
+      std::vector<ProximityResult::VertexFace> ab, ba;
+      std::vector<ProximityResult::EdgeEdge> ee;
+    };
+    tbb::enumerable_thread_specific<Found> locals;
+    const Scope scope{*this};
+    const auto& xa = a.x0;
+    const auto& xb = b.x0;
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          Found& out = locals.local();
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const auto [f, g] = pairs[i];
+            // No feature pair is closer than the whole triangles' bound.
+            if (detail::triangle_triangle_bound(detail::corners(xa, faces_a[f]),
+                                                detail::corners(xb, faces_b[g])) > h) {
+              continue;
+            }
+            face_pair(
+                ca, cb, f, g, scope,
+                [&](int v, int k) {
+                  const Face& t = faces_b[k];
+                  const double d =
+                      point_triangle_distance_if_within(xa[v], xb[t[0]], xb[t[1]], xb[t[2]], h);
+                  if (d <= h) out.ab.push_back({v, k, d});
+                },
+                [&](int u, int k) {
+                  const Face& t = faces_a[k];
+                  const double d =
+                      point_triangle_distance_if_within(xb[u], xa[t[0]], xa[t[1]], xa[t[2]], h);
+                  if (d <= h) out.ba.push_back({u, k, d});
+                },
+                [&](int x, int y) {
+                  const Edge &p = edges_a[x], &q = edges_b[y];
+                  const double d =
+                      edge_edge_distance_if_within(xa[p[0]], xa[p[1]], xb[q[0]], xb[q[1]], h);
+                  if (d <= h) out.ee.push_back({x, y, d});
+                });
+          }
+        });
+    PairProximityResult res;
+    for (const auto& l : locals) {
+      res.vf_a_on_b.insert(res.vf_a_on_b.end(), l.ab.begin(), l.ab.end());
+      res.vf_b_on_a.insert(res.vf_b_on_a.end(), l.ba.begin(), l.ba.end());
+      res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
+    }
+    sort_by_ids(res.vf_a_on_b);
+    sort_by_ids(res.vf_b_on_a);
+    sort_by_ids(res.ee);
+    return res;
   }
 };
 
@@ -162,61 +378,50 @@ PairDetector& PairDetector::operator=(PairDetector&&) noexcept = default;
 
 PairDetectResult PairDetector::detect(const Positions& a_t0, const Positions& a_t1,
                                       const Positions& b_t0, const Positions& b_t1) {
+  return impl_->detect(a_t0, a_t1, b_t0, b_t1);
+}
+PairProximityResult PairDetector::proximity(const Positions& a, const Positions& b, double h) {
+  return impl_->proximity(a, b, h);
+}
+void PairDetector::set_active_vertices(std::span<const int> vertices_a,
+                                       std::span<const int> vertices_b) {
   Impl& m = *impl_;
-  detail::to_points(a_t0, m.ta.num_vertices(), "mesh A at t0", m.a0);
-  detail::to_points(a_t1, m.ta.num_vertices(), "mesh A at t1", m.a1);
-  detail::to_points(b_t0, m.tb.num_vertices(), "mesh B at t0", m.b0);
-  detail::to_points(b_t1, m.tb.num_vertices(), "mesh B at t1", m.b1);
-  auto t = Clock::now();
-  RefitOptions ro;
-  ro.thickness = m.opt.thickness;
-  ro.cones = false;  // no self-collision between two objects: cones cannot cull
-  m.ba.refit(m.a0, m.a1, ro);
-  m.bb.refit(m.b0, m.b1, ro);
-  const double t_refit = std::chrono::duration<double>(Clock::now() - t).count();
-  PairDetectResult res;
-  if (m.ba.nodes().empty() || m.bb.nodes().empty()) return res;
-
-  t = Clock::now();
-  struct Pairs {
-    std::vector<std::pair<int, int>> v;
-  };
-  const auto& pa = m.ba.prim_ids();
-  const auto& pb = m.bb.prim_ids();
-  const auto& na = m.ba.nodes();
-  const auto& nb = m.bb.nodes();
-  auto tr = detail::make_traversal(
-      std::span<const BvhNode>(na), std::span<const BvhNode>(nb), {}, {},
-      [](int, detail::TraversalCounters&) { return false; },
-      [&](int x, int y, Pairs& out) { out.v.emplace_back(pa[na[x].first], pb[nb[y].first]); });
-  tbb::enumerable_thread_specific<Pairs> plocals;
-  const auto counters = detail::run_parallel(tr, {0, 0, false}, plocals);
-  std::vector<std::pair<int, int>> pairs;
-  for (const auto& l : plocals)
-    pairs.insert(pairs.end(), l.v.begin(), l.v.end());
-  const double t_trav = std::chrono::duration<double>(Clock::now() - t).count();
-
-  t = Clock::now();
-  const PairKernels k{{&m.ta, m.a0, m.a1},
-                      {&m.tb, m.b0, m.b1},
-                      0.5 * m.opt.thickness,
-                      m.opt.np_filter,
-                      CcdOptions{m.opt.thickness, m.opt.fast_path}};
-  tbb::enumerable_thread_specific<Buffer> locals;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      Buffer& out = locals.local();
-                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                        k.face_pair(pairs[i].first, pairs[i].second, out, false);
-                      }
-                    });
-  res = collect(locals, false);
-  res.stats.time_refit = t_refit;
-  res.stats.time_traverse = t_trav;
-  res.stats.time_narrow = std::chrono::duration<double>(Clock::now() - t).count();
-  res.stats.box_tests = counters.box_tests;
-  res.stats.triangle_pairs = pairs.size();
-  return res;
+  m.a.set_active(vertices_a, "A");
+  m.b.set_active(vertices_b, "B");
+  m.restricted = true;
+}
+void PairDetector::clear_active() {
+  impl_->restricted = false;
+}
+void PairDetector::rebuild(const Positions& reference_a, const Positions& reference_b) {
+  Impl& m = *impl_;
+  std::vector<Eigen::Vector3d> ra, rb;
+  detail::to_points(reference_a, m.a.topo.num_vertices(), "reference shape A", ra);
+  detail::to_points(reference_b, m.b.topo.num_vertices(), "reference shape B", rb);
+  m.a.bvh = Bvh::boxes_only(m.a.topo, ra, m.opt.build);
+  m.b.bvh = Bvh::boxes_only(m.b.topo, rb, m.opt.build);
+  m.restricted = false;  // its node flags belonged to the old trees
+}
+const DetectOptions& PairDetector::options() const {
+  return impl_->opt;
+}
+void PairDetector::set_options(const DetectOptions& options) {
+  check_pair_options(options);
+  const BvhBuild build = impl_->opt.build;
+  impl_->opt = options;
+  impl_->opt.build = build;
+}
+const Topology& PairDetector::topology_a() const {
+  return impl_->a.topo;
+}
+const Topology& PairDetector::topology_b() const {
+  return impl_->b.topo;
+}
+const Bvh& PairDetector::bvh_a() const {
+  return impl_->a.bvh;
+}
+const Bvh& PairDetector::bvh_b() const {
+  return impl_->b.bvh;
 }
 
 PairDetectResult brute_force_detect_pair(const Topology& a, const Positions& a_t0,
@@ -228,19 +433,37 @@ PairDetectResult brute_force_detect_pair(const Topology& a, const Positions& a_t
   detail::to_points(a_t1, a.num_vertices(), "mesh A at t1", a1);
   detail::to_points(b_t0, b.num_vertices(), "mesh B at t0", b0);
   detail::to_points(b_t1, b.num_vertices(), "mesh B at t1", b1);
-  const PairKernels k{{&a, a0, a1},
-                      {&b, b0, b1},
-                      0.5 * options.thickness,
-                      options.np_filter,
-                      CcdOptions{options.thickness, options.fast_path}};
+  const detail::FeatureContext ca = detail::ccd_context(a, a0, a1, options);
+  const detail::FeatureContext cb = detail::ccd_context(b, b0, b1, options);
   tbb::enumerable_thread_specific<Buffer> locals;
-  // Every face pair with every feature: duplicates removed afterwards.
-  tbb::parallel_for(0, a.num_faces(), [&](int fa) {
+  // Every vertex against every face of the other mesh, every edge against every edge.
+  auto vertex_faces = [&](const detail::FeatureContext& sv, const detail::FeatureContext& sf,
+                          auto member) {
+    tbb::parallel_for(0, sv.topo->num_vertices(), [&](int v) {
+      if (sv.topo->vertex_faces(v).empty()) return;
+      Buffer& out = locals.local();
+      const detail::Box bv = sv.vertex_box(v);
+      for (int f = 0; f < sf.topo->num_faces(); ++f) {
+        double toi = 1.0;
+        if (detail::overlap(bv, sf.face_box(f)) && vf_hit(ca, sv, v, sf, f, out.c, toi)) {
+          (out.*member).push_back({v, f, sf.topo->faces()[f], toi});
+        }
+      }
+    });
+  };
+  vertex_faces(ca, cb, &Buffer::ab);
+  vertex_faces(cb, ca, &Buffer::ba);
+  tbb::parallel_for(0, a.num_edges(), [&](int ea) {
     Buffer& out = locals.local();
-    for (int fb = 0; fb < b.num_faces(); ++fb)
-      k.face_pair(fa, fb, out, true);
+    const detail::Box xa = ca.edge_box(ea);
+    for (int eb = 0; eb < b.num_edges(); ++eb) {
+      double toi = 1.0;
+      if (detail::overlap(xa, cb.edge_box(eb)) && ee_hit(ca, ea, cb, eb, out.c, toi)) {
+        out.ee.push_back({ea, eb, a.edges()[ea], b.edges()[eb], toi});
+      }
+    }
   });
-  return collect(locals, true);
+  return collect(locals);
 }
 
 }  // namespace clothcd

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <optional>
 
-#include "bvh_pairs.hpp"
 #include "clothcd/bvh/bvh.hpp"
+#include "detect/traversal.hpp"
 #include "fitted_tree.hpp"
 #include "seam_links.hpp"
 
@@ -27,10 +27,25 @@ bool segment_crosses(const Vec3& p, const Vec3& q, double dp, double dq, const V
   return (s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0);
 }
 
-// The pairs the threads found, sorted: the same list whatever the thread count.
-std::vector<std::pair<int, int>> merged(
-    const tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>>& found) {
+// Calls fn(f, g, local) for every overlapping leaf pair of a self traversal of `a` (b == nullptr:
+// each unordered pair of distinct leaves once) or of a pair traversal of a and b, in parallel;
+// returns what fn collected, sorted: the same list whatever the thread count.
+template <class Fn>
+std::vector<std::pair<int, int>> overlapping(const Bvh& a, const Bvh* b, Fn&& fn) {
+  using Local = std::vector<std::pair<int, int>>;
+  const Bvh& other = b != nullptr ? *b : a;
   std::vector<std::pair<int, int>> out;
+  if (a.nodes().empty() || other.nodes().empty()) return out;
+  const auto& na = a.nodes();
+  const auto& nb = other.nodes();
+  auto tr = ::clothcd::detail::make_traversal(
+      std::span<const BvhNode>(na), std::span<const BvhNode>(nb), {}, {},
+      [](int, ::clothcd::detail::TraversalCounters&) { return false; },
+      [&](int x, int y, Local& local) {
+        fn(a.prim_ids()[na[x].first], other.prim_ids()[nb[y].first], local);
+      });
+  tbb::enumerable_thread_specific<Local> found;
+  (void)::clothcd::detail::run_parallel(tr, {0, 0, b == nullptr}, found);
   for (const auto& local : found)
     out.insert(out.end(), local.begin(), local.end());
   std::sort(out.begin(), out.end());
@@ -93,34 +108,25 @@ std::vector<std::pair<int, int>> IntersectionCounter::self_pairs(std::span<const
   ro.cones = false;
   im.cloth_tree.refit(x, ro);
   const auto& faces = im.cloth.faces();
-  tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>> found;
-  detail::for_each_self_overlap_parallel(im.cloth_tree.bvh(), found,
-                                         [&](int f, int g, auto& local) {
-                                           if (im.skip_self(f, g)) return;
-                                           if (Impl::test(x, faces[f], x, faces[g]))
-                                             local.emplace_back(std::min(f, g), std::max(f, g));
-                                         });
-  return merged(found);
+  return overlapping(im.cloth_tree.bvh(), nullptr, [&](int f, int g, auto& local) {
+    if (im.skip_self(f, g)) return;
+    if (Impl::test(x, faces[f], x, faces[g])) local.emplace_back(std::min(f, g), std::max(f, g));
+  });
 }
 
 std::vector<std::pair<int, int>> IntersectionCounter::body_pairs(std::span<const Vec3> x,
                                                                  std::span<const Vec3> body) {
   Impl& im = *impl_;
-  std::vector<std::pair<int, int>> out;
-  if (!im.body) return out;
+  if (!im.body) return {};
   RefitOptions ro;
   ro.cones = false;
   im.cloth_tree.refit(x, ro);
   im.body_tree.refit(body, ro);
   const auto& cf = im.cloth.faces();
   const auto& bf = im.body->faces();
-  tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>> found;
-  detail::for_each_overlap_parallel(im.cloth_tree.bvh(), im.body_tree.bvh(), found,
-                                    [&](int f, int g, auto& local) {
-                                      if (Impl::test(x, cf[f], body, bf[g]))
-                                        local.emplace_back(f, g);
-                                    });
-  return merged(found);
+  return overlapping(im.cloth_tree.bvh(), &im.body_tree.bvh(), [&](int f, int g, auto& local) {
+    if (Impl::test(x, cf[f], body, bf[g])) local.emplace_back(f, g);
+  });
 }
 
 std::vector<std::pair<int, int>> IntersectionCounter::self_pairs_brute_force(

@@ -78,14 +78,29 @@ class SelfDetector {
 
 /// Collisions between two meshes A (e.g. a garment) and B (e.g. a body); no self-collisions.
 struct PairDetectResult {
-  std::vector<VertexFaceCollision> vf_a_on_b;  ///< vertex of A, face of B
-  std::vector<VertexFaceCollision> vf_b_on_a;  ///< vertex of B, face of A
-  std::vector<EdgeEdgeCollision> ee;           ///< edge_a of A, edge_b of B
+  std::vector<VertexFaceCollision> vf_a_on_b;  ///< vertex of A, face of B; sorted
+  std::vector<VertexFaceCollision> vf_b_on_a;  ///< vertex of B, face of A; sorted
+  std::vector<EdgeEdgeCollision> ee;           ///< edge_a of A, edge_b of B; sorted
   DetectStats stats;
 };
 
+/// Proximity pairs between two meshes: features of A and B closer than h at one instant.
+struct PairProximityResult {
+  std::vector<ProximityResult::VertexFace> vf_a_on_b;  ///< vertex of A, face of B; sorted
+  std::vector<ProximityResult::VertexFace> vf_b_on_a;  ///< vertex of B, face of A; sorted
+  std::vector<ProximityResult::EdgeEdge> ee;           ///< edge_a of A, edge_b of B; sorted
+};
+
+/// Detection between two meshes with the self detector's kernels and options: thickness (boxes
+/// grow with it; above zero the distance filter with distance_filter_depth replaces the cubic NP
+/// filter), np_filter, fast_path, toi_tolerance and build mean what they mean for SelfDetector.
+/// Each feature pair is tested once; results are sorted and do not depend on the thread count.
 class PairDetector {
  public:
+  /// Builds both topologies and box-only BVHs (split on the references). Throws InputError on
+  /// bad faces, a reference of the wrong size, or options it cannot honour between two meshes:
+  /// a culling other than Culling::None (cones cull self tests only), verify, reuse_distance
+  /// other than 0, linked_vertices (they join vertices of one mesh), a negative thickness.
   PairDetector(std::vector<Face> faces_a, int num_vertices_a, const Positions& reference_a,
                std::vector<Face> faces_b, int num_vertices_b, const Positions& reference_b,
                const DetectOptions& options = {});
@@ -93,8 +108,34 @@ class PairDetector {
   PairDetector(PairDetector&&) noexcept;
   PairDetector& operator=(PairDetector&&) noexcept;
 
+  /// All VF and EE pairs between A and B that touch during the linear motions a_t0 -> a_t1 and
+  /// b_t0 -> b_t1. A call after another detect() redoes only the boxes over moved vertices (the
+  /// same results as from scratch): a simulator's later passes pay for what changed.
   [[nodiscard]] PairDetectResult detect(const Positions& a_t0, const Positions& a_t1,
                                         const Positions& b_t0, const Positions& b_t1);
+
+  /// VF and EE pairs between A and B closer than h at positions a and b, with their distances
+  /// (box culling only); honours the active restriction like detect().
+  [[nodiscard]] PairProximityResult proximity(const Positions& a, const Positions& b, double h);
+
+  /// Restricts detection to pairs with an active vertex (ids of A and of B): a VF pair when its
+  /// vertex or a vertex of its face is active, an EE pair when an endpoint is active. Throws
+  /// InputError for an id out of range.
+  void set_active_vertices(std::span<const int> vertices_a, std::span<const int> vertices_b = {});
+  void clear_active();
+
+  /// Builds both BVHs afresh, split on the references (see SelfDetector::rebuild: results do not
+  /// change, loose boxes of a tree refit far from its build shape cost time). Clears an active
+  /// restriction. Throws InputError for a reference of the wrong size.
+  void rebuild(const Positions& reference_a, const Positions& reference_b);
+
+  [[nodiscard]] const DetectOptions& options() const;
+  /// Throws InputError like the constructor; the BVH build stays as constructed.
+  void set_options(const DetectOptions& options);
+  [[nodiscard]] const Topology& topology_a() const;
+  [[nodiscard]] const Topology& topology_b() const;
+  [[nodiscard]] const Bvh& bvh_a() const;
+  [[nodiscard]] const Bvh& bvh_b() const;
 
  private:
   struct Impl;

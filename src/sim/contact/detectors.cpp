@@ -1,0 +1,59 @@
+// Creation and rebuilds of the contact stage's detectors.
+#include "sim/contact/detectors.hpp"
+
+#include "sim/fitted_tree.hpp"
+
+namespace clothcd::sim::detail {
+
+DetectOptions ccd_detect_options(const ContactOptions& o) {
+  DetectOptions d;
+  d.thickness = o.ccd_thickness;
+  d.toi_tolerance = o.toi_tolerance;
+  d.distance_filter_depth = o.distance_filter_depth;
+  return d;
+}
+
+SelfDetector& ContactDetectors::start_self(const ContactGeometry& g) {
+  if (!self_) {
+    DetectOptions o = ccd_detect_options(opt_);
+    o.culling = Culling::Sound;  // never the unsound cone rules in the simulator
+    // The proximity query (at the repulsion distance) then reuses the last CCD pass's pairs.
+    o.reuse_distance = opt_.thickness;
+    // Seam-linked vertices count as one point: the seam's sides touch by design.
+    o.linked_vertices = model_.seam_links();
+    self_.emplace(model_.topology().faces(), model_.num_vertices(), g.x0m, o);
+  } else if (self_fit_ > 0.0 && FittedTree::loosened(self_->bvh().box_area_ratio(), self_fit_)) {
+    self_->rebuild(g.x0m);  // its boxes are still the last CCD pass's
+    self_fit_ = 0.0;
+  }
+  return *self_;
+}
+
+void ContactDetectors::self_pass_done() {
+  if (self_fit_ == 0.0) self_fit_ = self_->bvh().box_area_ratio();
+}
+
+PairDetector& ContactDetectors::start_body(const SubstepContext& ctx, ContactGeometry& g) {
+  if (!body_) {
+    body_.emplace(model_.topology().faces(), model_.num_vertices(), g.x0m, *ctx.body_faces,
+                  static_cast<int>(ctx.body_t0.size()), g.b0m, ccd_detect_options(opt_));
+  }
+  g.set_body(&body_->topology_b());
+  return *body_;
+}
+
+void ContactDetectors::body_proximity_done(const ContactGeometry& g) {
+  const std::array<double, 2> ratio{body_->bvh_a().box_area_ratio(),
+                                    body_->bvh_b().box_area_ratio()};
+  if (body_fit_[0] == 0.0) {
+    body_fit_ = ratio;
+    return;
+  }
+  if (FittedTree::loosened(ratio[0], body_fit_[0]) ||
+      FittedTree::loosened(ratio[1], body_fit_[1])) {
+    body_->rebuild(g.x0m, g.b0m);
+    body_fit_ = {0.0, 0.0};
+  }
+}
+
+}  // namespace clothcd::sim::detail
