@@ -202,7 +202,8 @@ TEST(OptimalCone, SetsInsideAnOpenHemisphereDoNotSaturate) {
     ASSERT_FALSE(c.saturated()) << std::setprecision(17) << "seed " << seed;
     // Near the equator the cap is ill-conditioned: its axis moves by ~eps / cos(theta).
     ASSERT_LE(c.half_angle, std::numbers::pi / 2 - margin + 2 * kConeSlack + 1e-15 / margin)
-        << std::setprecision(17) << "seed " << seed;
+        << std::setprecision(17) << "seed " << seed << " margin " << margin << " n " << n
+        << " excess " << c.half_angle - (std::numbers::pi / 2 - margin);
   }
 }
 
