@@ -10,9 +10,11 @@
 // enclosing ball of the tips avoids two numerical traps of the ball form: acos|q| cannot resolve
 // half-angles below ~1e-8 rad, and four co-circular tips make the circumsphere singular.
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
