@@ -64,8 +64,11 @@ void Bvh::refit_levels(const RefitOptions& options, std::span<const std::uint8_t
     control_dirs_.resize(3 * prim_ids_.size());
     degenerate_.resize(prim_ids_.size());
   }
+  // An optimal cone costs time linear in the node's size, so the few nodes of the upper levels
+  // hold most of the work: split those levels down to single nodes.
+  const int grain = optimal ? 1 : 256;
   for (int d = depth() - 1; d >= 0; --d) {
-    tbb::parallel_for(tbb::blocked_range<int>(level_offsets_[d], level_offsets_[d + 1], 256),
+    tbb::parallel_for(tbb::blocked_range<int>(level_offsets_[d], level_offsets_[d + 1], grain),
                       [&](const tbb::blocked_range<int>& range) {
                         for (int i = range.begin(); i != range.end(); ++i) {
                           if (!only.empty() && only[i] == 0) continue;
@@ -92,9 +95,15 @@ void Bvh::refit_levels(const RefitOptions& options, std::span<const std::uint8_t
                           } else if (!optimal) {
                             cones_[i] = merge_tight(cl, cr);
                           } else {
-                            cones_[i] = optimal_cone(std::span<const Eigen::Vector3d>(
-                                control_dirs_.data() + 3 * static_cast<std::size_t>(n.first),
-                                3 * static_cast<std::size_t>(n.count)));
+                            // The children's cones enclose their halves of the node's
+                            // directions: their rim directions start the search.
+                            const ConePart parts[2] = {{3 * static_cast<std::size_t>(l.count), cl},
+                                                       {3 * static_cast<std::size_t>(r.count), cr}};
+                            cones_[i] = optimal_cone(
+                                std::span<const Eigen::Vector3d>(
+                                    control_dirs_.data() + 3 * static_cast<std::size_t>(n.first),
+                                    3 * static_cast<std::size_t>(n.count)),
+                                parts);
                           }
                         }
                       });

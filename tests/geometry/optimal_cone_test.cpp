@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <vector>
 
 #include "clothcd/geometry/cone.hpp"
@@ -202,7 +203,8 @@ TEST(OptimalCone, SetsInsideAnOpenHemisphereDoNotSaturate) {
     ASSERT_FALSE(c.saturated()) << std::setprecision(17) << "seed " << seed;
     // Near the equator the cap is ill-conditioned: its axis moves by ~eps / cos(theta).
     ASSERT_LE(c.half_angle, std::numbers::pi / 2 - margin + 2 * kConeSlack + 1e-15 / margin)
-        << std::setprecision(17) << "seed " << seed;
+        << std::setprecision(17) << "seed " << seed << " margin " << margin << " n " << n
+        << " excess " << c.half_angle - (std::numbers::pi / 2 - margin);
   }
 }
 
@@ -232,6 +234,232 @@ TEST(OptimalCone, LargeSetsAreLocallyOptimalAndDeterministic) {
     std::reverse(shuffled.begin(), shuffled.end());
     ASSERT_NEAR(optimal_cone(shuffled).half_angle, c.half_angle, 1e-14 + 1e-12 * c.half_angle);
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Degenerate families at every size: the shapes cloth normals take (flat patches repeat one
+// direction, cylinders put them on a great circle, folds and crumples span a hemisphere).
+
+enum class Family {
+  Random,          // uniform in a cap of the given radius
+  Equal,           // one direction repeated, at random lengths
+  Antipodal,       // a random set plus an antiparallel pair: saturated
+  ArcOfCircle,     // on a great-circle arc shorter than pi: the diametral cap of its ends
+  FullCircle,      // spread over more than half a great circle: saturated
+  NearHemisphere,  // pi/2 - margin from a pole, all around it
+  Clustered,       // two to four clusters of spread 1e-12 rad
+  Tiny,            // uniform in a cap of radius 1e-12 rad
+  CoCircular,      // mostly on the rim of a cap, some inside
+};
+constexpr Family kFamilies[] = {Family::Random,      Family::Equal,      Family::Antipodal,
+                                Family::ArcOfCircle, Family::FullCircle, Family::NearHemisphere,
+                                Family::Clustered,   Family::Tiny,       Family::CoCircular};
+
+// Whether a set of the family of that size has no cone below pi/2.
+bool saturates(Family f, int n) {
+  return (f == Family::Antipodal && n >= 2) || (f == Family::FullCircle && n >= 3);
+}
+
+std::vector<Eigen::Vector3d> family_set(Family f, Rng& rng, int n) {
+  const Eigen::Vector3d c = rng.unit();
+  const Eigen::Vector3d e = rng.perpendicular(c);
+  const double scale = rng.log_uniform(1e-12, 1.5);
+  std::vector<Eigen::Vector3d> v;
+  auto in_cap = [&](const Eigen::Vector3d& centre, double radius) {
+    return test::rotate(centre, rng.perpendicular(centre), radius * std::sqrt(rng.uniform()));
+  };
+  // On the great circle through c along e, at signed angle t from c.
+  auto on_circle = [&](long double t) { return test::rotate(c, e, t); };
+  switch (f) {
+    case Family::Random:
+      for (int i = 0; i < n; ++i)
+        v.push_back(in_cap(c, scale));
+      break;
+    case Family::Equal:
+      for (int i = 0; i < n; ++i)
+        v.push_back(c * (i == 0 ? 1.0 : rng.log_uniform(1e-3, 1e3)));
+      break;
+    case Family::Antipodal:
+      for (int i = 0; i + 2 < n; ++i)
+        v.push_back(in_cap(c, scale));
+      v.insert(v.begin() + rng.integer(0, static_cast<int>(v.size())), c);
+      v.insert(v.begin() + rng.integer(0, static_cast<int>(v.size())), -c);
+      break;
+    case Family::ArcOfCircle: {
+      const double half = std::min(scale, 1.5);
+      for (int i = 0; i < n; ++i)
+        v.push_back(on_circle(i < 2 ? (i == 0 ? -half : half) : rng.uniform(-half, half)));
+      std::swap(v[0], v[rng.integer(0, n - 1)]);
+      break;
+    }
+    case Family::FullCircle:
+      // Both ends and the middle pin the set to more than a half circle.
+      for (int i = 0; i < n; ++i) {
+        const long double t = i < 3 ? (i - 1) * 0.6L * std::numbers::pi_v<long double>
+                                    : rng.uniform(-0.6, 0.6) * std::numbers::pi;
+        v.push_back(on_circle(t));
+      }
+      for (int i = 0; i < n; ++i)
+        std::swap(v[i], v[rng.integer(i, n - 1)]);
+      break;
+    case Family::NearHemisphere: {
+      const double margin = rng.log_uniform(1e-6, 1e-2);
+      for (int i = 0; i < n; ++i)
+        v.push_back(test::rotate(c, rng.perpendicular(c), std::numbers::pi / 2 - margin));
+      break;
+    }
+    case Family::Clustered: {
+      std::vector<Eigen::Vector3d> centres;
+      for (int k = rng.integer(2, 4); k > 0; --k)
+        centres.push_back(in_cap(c, scale));
+      for (int i = 0; i < n; ++i)
+        v.push_back(in_cap(centres[rng.integer(0, static_cast<int>(centres.size()) - 1)], 1e-12));
+      break;
+    }
+    case Family::Tiny:
+      for (int i = 0; i < n; ++i)
+        v.push_back(in_cap(c, 1e-12));
+      break;
+    case Family::CoCircular:
+      for (int i = 0; i < n; ++i) {
+        const double t = rng.chance(0.8) ? scale : scale * std::sqrt(rng.uniform());
+        v.push_back(test::rotate(c, rng.perpendicular(c), t));
+      }
+      break;
+  }
+  if (n == 1 && v.size() > 1) v.resize(1);
+  return v;
+}
+
+// The angle from `axis` to `p` in long double, with the cross product taken as a x (p - a), so
+// it keeps full relative precision at 1e-12 rad.
+long double angle_precise(const Eigen::Vector3d& axis, const Eigen::Vector3d& p) {
+  const Vec3L a = to_ld(axis), q = to_ld(p).normalized();
+  return std::atan2(a.cross(q - a).norm(), a.dot(q));
+}
+
+long double needed_precise(const Eigen::Vector3d& axis, const std::vector<Eigen::Vector3d>& v) {
+  long double worst = 0;
+  for (const auto& p : v)
+    worst = std::max(worst, angle_precise(axis, p));
+  return worst;
+}
+
+// Optimality certificate of a cap (the minimal cap's optimality condition): the directions from
+// the axis toward the rim points (those within 1e-8 of the largest angle, or 1e-14 rad) leave no
+// gap above pi around the axis; otherwise moving the axis into the gap would shrink every rim
+// angle.
+bool certified_minimal(const Eigen::Vector3d& axis, const std::vector<Eigen::Vector3d>& v) {
+  const long double theta = needed_precise(axis, v);
+  if (theta < 1e-14L) return true;  // the oracles' absolute tolerance
+  const Vec3L a = to_ld(axis);
+  const Vec3L u = a.unitOrthogonal(), w = a.cross(u);
+  std::vector<long double> phi;
+  for (const auto& p : v) {
+    if (angle_precise(axis, p) < theta * (1 - 1e-8L) - 1e-14L) continue;
+    const Vec3L q = to_ld(p).normalized();
+    const Vec3L t = a.cross(q - a);  // the tangent toward p, turned by 90 degrees about a
+    phi.push_back(std::atan2(t.dot(w), t.dot(u)));
+  }
+  std::sort(phi.begin(), phi.end());
+  long double gap = phi.front() + 2 * std::numbers::pi_v<long double> - phi.back();
+  for (std::size_t i = 1; i < phi.size(); ++i)
+    gap = std::max(gap, phi[i] - phi[i - 1]);
+  // An axis off by the 1e-14 rad of the oracles' tolerance turns the rim directions by 1e-14 /
+  // theta.
+  return gap <= std::numbers::pi_v<long double> + 1e-6L + 1e-14L / theta;
+}
+
+TEST(OptimalCone, DegenerateFamiliesMatchBruteForce) {
+  for (const Family f : kFamilies) {
+    for (int seed = 0; seed < kCases / 250; ++seed) {
+      Rng rng(seed);
+      const int n = rng.integer(1, 9);
+      const auto set = family_set(f, rng, n);
+      const NormalCone c = optimal_cone(set);
+      const auto pts = unit_ld(set);
+      // Spread of the set, for the choice of oracle.
+      long double spread = 0;
+      for (const auto& p : pts)
+        spread = std::max(spread, angle_ld(pts[0], p));
+      const long double brute =
+          spread > 2e-5L ? brute_force_spherical(pts) : brute_force_planar(pts);
+      const auto trace = ::testing::Message() << std::setprecision(17) << "family " << int(f)
+                                              << " seed " << seed << " n " << n;
+      if (c.saturated()) {
+        ASSERT_GE(brute, std::numbers::pi / 2 - 1e-9) << trace;
+        continue;
+      }
+      ASSERT_LE(needed_precise(c.axis, set), c.half_angle) << trace;  // containment
+      ASSERT_NEAR(static_cast<double>(c.half_angle - kConeSlack), static_cast<double>(brute),
+                  static_cast<double>(1e-14L + 2e-9L * brute))
+          << trace;
+    }
+  }
+}
+
+TEST(OptimalCone, DegenerateFamiliesAtEverySizeAreContainedAndOptimal) {
+  for (const Family f : kFamilies) {
+    for (const int n : {1, 2, 3, 4, 7, 30, 300, 2000}) {
+      for (int seed = 0; seed < 12; ++seed) {
+        Rng rng(1000 * n + seed);
+        const auto set = family_set(f, rng, n);
+        const NormalCone c = optimal_cone(set);
+        const auto trace = ::testing::Message() << std::setprecision(17) << "family " << int(f)
+                                                << " seed " << seed << " n " << n;
+        const NormalCone again = optimal_cone(set);
+        ASSERT_EQ(c.axis, again.axis) << trace;
+        ASSERT_EQ(c.half_angle, again.half_angle) << trace;
+        if (saturates(f, n)) {
+          ASSERT_TRUE(c.saturated()) << trace;
+          continue;
+        }
+        ASSERT_FALSE(c.saturated()) << trace;
+        ASSERT_LE(needed_precise(c.axis, set), c.half_angle) << trace;
+        ASSERT_TRUE(certified_minimal(c.axis, set)) << trace;
+        // The certificate has teeth: an axis moved by a thousandth of the angle fails it.
+        if (c.half_angle > 1e-9) {
+          const Eigen::Vector3d moved =
+              test::rotate(c.axis, rng.perpendicular(c.axis), 1e-3 * c.half_angle);
+          ASSERT_FALSE(certified_minimal(moved, set)) << trace;
+        }
+      }
+    }
+  }
+}
+
+// Random partitions of a set, with the parts' optimal cones or with cones that are wrong: the
+// hints change the search, never the cone (beyond rounding) nor containment.
+TEST(OptimalCone, PartsOnlyOrderTheSearch) {
+  for (int seed = 0; seed < 400; ++seed) {
+    Rng rng(seed);
+    const Family f = kFamilies[rng.integer(0, std::size(kFamilies) - 1)];
+    const int n = rng.integer(1, 600);
+    const auto set = family_set(f, rng, n);
+    const NormalCone plain = optimal_cone(set);
+    std::vector<ConePart> parts;
+    const bool wrong = rng.chance(0.3);
+    for (std::size_t begin = 0; begin < set.size();) {
+      const std::size_t count =
+          std::min<std::size_t>(set.size() - begin, rng.integer(1, 1 + n / 2));
+      const std::span<const Eigen::Vector3d> part(set.data() + begin, count);
+      parts.push_back(
+          {count, wrong ? NormalCone{rng.unit(), rng.uniform(0.0, 2.0)} : optimal_cone(part)});
+      begin += count;
+    }
+    const NormalCone hinted = optimal_cone(set, parts);
+    const auto trace = ::testing::Message() << std::setprecision(17) << "family " << int(f)
+                                            << " seed " << seed << " n " << n;
+    ASSERT_EQ(hinted.saturated(), plain.saturated()) << trace;
+    if (plain.saturated()) continue;
+    ASSERT_LE(needed_precise(hinted.axis, set), hinted.half_angle) << trace;
+    // The tolerance of the brute-force comparisons: the search's containment test lets points in
+    // up to 1e-14 rad (a hundredth of kConeSlack).
+    ASSERT_NEAR(hinted.half_angle, plain.half_angle, 1e-14 + 1e-11 * plain.half_angle) << trace;
+  }
+  const std::vector<Eigen::Vector3d> set(5, Eigen::Vector3d::UnitZ());
+  const std::vector<ConePart> short_parts = {{2, {}}, {2, {}}};
+  EXPECT_THROW((void)optimal_cone(set, short_parts), std::invalid_argument);
 }
 
 }  // namespace

@@ -101,10 +101,28 @@ struct BernsteinNormal {
 [[nodiscard]] NormalCone dcd_leaf_cone(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c);
 
-/// The minimal cone enclosing the given unit vectors (expected linear time, via the minimum
-/// enclosing ball of the tips). Saturated when no cone below pi/2 exists.
+/// The minimal cone enclosing the given unit vectors, in expected linear time (a randomized
+/// incremental search on the sphere, seeded by the set's size: the same input always gives the
+/// same cone). Saturated when no cone below pi/2 exists, i.e. when no open hemisphere holds the
+/// set. The half-angle is the largest angle from the axis to any input plus `kConeSlack`, so
+/// every input is contained; it exceeds the minimum by at most ~1e-12 of it (rounding).
 /// Vectors need not be exactly unit (only directions matter); a zero vector saturates; an empty
 /// span throws std::invalid_argument.
 [[nodiscard]] NormalCone optimal_cone(std::span<const Eigen::Vector3d> unit_vectors);
+
+/// A run of consecutive vectors of a set together with a cone believed to enclose them (e.g. a
+/// tree node's child and its optimal cone).
+struct ConePart {
+  std::size_t count = 0;
+  NormalCone cone;
+};
+
+/// optimal_cone(unit_vectors) for a set split into consecutive `parts` (their counts must add up
+/// to the set's size, else std::invalid_argument): each part's three vectors farthest from its
+/// cone's axis are tried first, which saves most of the search when the cones are optimal. The
+/// parts only order the search: whatever their cones, the result is the minimal cone (up to
+/// rounding) and contains every vector.
+[[nodiscard]] NormalCone optimal_cone(std::span<const Eigen::Vector3d> unit_vectors,
+                                      std::span<const ConePart> parts);
 
 }  // namespace clothcd
