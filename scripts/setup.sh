@@ -8,6 +8,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libgmp-dev
   clang clang-format libclang-rt-14-dev
   python3-matplotlib
+  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-meshio
 )
 
 missing=()
