@@ -19,6 +19,13 @@ namespace clothcd::python {
 
 namespace py = pybind11;
 
+/// An argument converted by the functions below (any object numpy.asarray accepts); its own type
+/// so that signatures in docstrings read "ArrayLike" rather than "handle".
+struct ArrayLike {
+  py::object obj;
+  operator py::handle() const { return obj; }  // NOLINT: used where a handle is expected
+};
+
 /// Raises ValueError (through pybind11's translation of std::invalid_argument).
 [[noreturn]] void fail(const std::string& message);
 
@@ -60,3 +67,17 @@ py::array_t<Scalar> take(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
 [[nodiscard]] py::array_t<double> matrix_array(const Positions& m);
 
 }  // namespace clothcd::python
+
+namespace pybind11::detail {
+template <>
+struct type_caster<clothcd::python::ArrayLike> {
+  PYBIND11_TYPE_CASTER(clothcd::python::ArrayLike, const_name("numpy.typing.ArrayLike"));
+  bool load(handle src, bool) {
+    value.obj = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const clothcd::python::ArrayLike& src, return_value_policy, handle) {
+    return src.obj.inc_ref();
+  }
+};
+}  // namespace pybind11::detail

@@ -23,7 +23,7 @@ Query query_at(const double* q, py::ssize_t i) {
 }
 
 template <class Query>
-py::tuple batch(const py::handle& obj, const CcdOptions& opt, int threads) {
+py::tuple batch(const ArrayLike& obj, const CcdOptions& opt, int threads) {
   const auto q = float_array(obj, "q", 3);
   if (q.shape(1) != 8 || q.shape(2) != 3) {
     fail(fmt::format("q: expected a float array of shape (k, 8, 3), got {}", describe(q)));
@@ -95,7 +95,7 @@ void bind_ccd(py::module_& m) {
   const CcdOptions d;
   m.def(
       "vertex_face_ccd",
-      [](const py::handle& q, double thickness, bool fast_path, double tolerance,
+      [](const ArrayLike& q, double thickness, bool fast_path, double tolerance,
          double toi_tolerance, std::uint32_t max_boxes, int threads) {
         return batch<VertexFaceQuery>(
             q, options(thickness, fast_path, tolerance, toi_tolerance, max_boxes), threads);
@@ -107,7 +107,7 @@ void bind_ccd(py::module_& m) {
           .c_str());
   m.def(
       "edge_edge_ccd",
-      [](const py::handle& q, double thickness, bool fast_path, double tolerance,
+      [](const ArrayLike& q, double thickness, bool fast_path, double tolerance,
          double toi_tolerance, std::uint32_t max_boxes, int threads) {
         return batch<EdgeEdgeQuery>(
             q, options(thickness, fast_path, tolerance, toi_tolerance, max_boxes), threads);

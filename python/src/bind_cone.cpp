@@ -19,7 +19,7 @@ struct Batch {
   py::ssize_t k = 0;
 };
 
-Batch batch(const py::handle& obj, const char* name, std::vector<py::ssize_t> inner) {
+Batch batch(const ArrayLike& obj, const char* name, std::vector<py::ssize_t> inner) {
   py::array raw = py::module_::import("numpy").attr("asarray")(obj).cast<py::array>();
   const auto rank = static_cast<py::ssize_t>(inner.size());
   std::string want = "(";
@@ -75,8 +75,8 @@ py::tuple cones_out(const std::vector<NormalCone>& cones, bool single) {
   return py::make_tuple(axes, angles);
 }
 
-py::tuple merge(const py::handle& axis_a, const py::handle& angle_a, const py::handle& axis_b,
-                const py::handle& angle_b, NormalCone (*op)(const NormalCone&, const NormalCone&)) {
+py::tuple merge(const ArrayLike& axis_a, const ArrayLike& angle_a, const ArrayLike& axis_b,
+                const ArrayLike& angle_b, NormalCone (*op)(const NormalCone&, const NormalCone&)) {
   const Batch aa = batch(axis_a, "axis_a", {3}), ta = batch(angle_a, "half_angle_a", {});
   const Batch ab = batch(axis_b, "axis_b", {3}), tb = batch(angle_b, "half_angle_b", {});
   if (aa.single != ta.single || ab.single != tb.single || aa.k != ta.k || ab.k != tb.k ||
@@ -116,7 +116,7 @@ void bind_cone(py::module_& m) {
   m.attr("SATURATED_HALF_ANGLE") = kSaturatedHalfAngle;
   m.def(
       "merge_provot",
-      [](const py::handle& a, const py::handle& ta, const py::handle& b, const py::handle& tb) {
+      [](const ArrayLike& a, const ArrayLike& ta, const ArrayLike& b, const ArrayLike& tb) {
         return merge(a, ta, b, tb, &merge_provot);
       },
       py::arg("axis_a"), py::arg("half_angle_a"), py::arg("axis_b"), py::arg("half_angle_b"),
@@ -125,7 +125,7 @@ void bind_cone(py::module_& m) {
           .c_str());
   m.def(
       "merge_tight",
-      [](const py::handle& a, const py::handle& ta, const py::handle& b, const py::handle& tb) {
+      [](const ArrayLike& a, const ArrayLike& ta, const ArrayLike& b, const ArrayLike& tb) {
         return merge(a, ta, b, tb, &merge_tight);
       },
       py::arg("axis_a"), py::arg("half_angle_a"), py::arg("axis_b"), py::arg("half_angle_b"),
@@ -133,7 +133,7 @@ void bind_cone(py::module_& m) {
           .c_str());
   m.def(
       "ccd_leaf_cone",
-      [](const py::handle& t0, const py::handle& t1, const std::string& policy) {
+      [](const ArrayLike& t0, const ArrayLike& t1, const std::string& policy) {
         const Batch a = batch(t0, "T0", {3, 3}), b = batch(t1, "T1", {3, 3});
         if (a.single != b.single || a.k != b.k) {
           fail(fmt::format("T0 and T1 must have the same shape, got {} and {}", describe(a.a),
@@ -156,7 +156,7 @@ Returns (axis, half_angle) or (axes (k, 3), half-angles (k,)); saturated (pi/2) 
 degenerates during the step.)");
   m.def(
       "optimal_cone",
-      [](const py::handle& vectors) {
+      [](const ArrayLike& vectors) {
         const auto a = float_array(vectors, "vectors", 2);
         if (a.shape(1) != 3) {
           fail(fmt::format("vectors: expected a float array of shape (n, 3), got {}", describe(a)));

@@ -225,8 +225,8 @@ struct PairResult {
 // The Python SelfDetector: the library's, its worker arena and the arrays it was built from.
 class PySelfDetector {
  public:
-  PySelfDetector(const py::handle& F, const py::handle& V, const std::string& bvh,
-                 const OptionArgs& args, int threads, const py::handle& linked)
+  PySelfDetector(const ArrayLike& F, const ArrayLike& V, const std::string& bvh,
+                 const OptionArgs& args, int threads, const ArrayLike& linked)
       : workers_(threads), bvh_(bvh) {
     std::vector<Face> f = faces(F, "F");
     const Positions v = positions(V, "V_rest");
@@ -234,7 +234,7 @@ class PySelfDetector {
     o.build = build_of(bvh);
     o.culling = Culling::Sound;
     args.apply(o);
-    if (!linked.is_none()) o.linked_vertices = index_pairs(linked, "linked_vertices");
+    if (!linked.obj.is_none()) o.linked_vertices = index_pairs(linked, "linked_vertices");
     det_.emplace(
         workers_.run([&] { return SelfDetector(std::move(f), static_cast<int>(v.rows()), v, o); }));
     // Linked ids are checked at the first detect(); check them now, at the call that gave them.
@@ -248,30 +248,30 @@ class PySelfDetector {
     }
   }
 
-  SelfResult detect(const py::handle& V0, const py::handle& V1) {
+  SelfResult detect(const ArrayLike& V0, const ArrayLike& V1) {
     const Positions a = positions(V0, "V0"), b = positions(V1, "V1");
     DetectResult r = workers_.run([&] { return det_->detect(a, b); });
     return SelfResult(r);
   }
 
-  ProximityOut proximity(const py::handle& V, double h) {
+  ProximityOut proximity(const ArrayLike& V, double h) {
     const Positions a = positions(V, "V");
     ProximityResult r = workers_.run([&] { return det_->proximity(a, h); });
     return ProximityOut(r);
   }
 
-  void set_active_vertices(const py::handle& ids) {
+  void set_active_vertices(const ArrayLike& ids) {
     const std::vector<int> v = indices(ids, "ids");
     workers_.run([&] { det_->set_active_vertices(v); });
   }
-  void set_active_faces(const py::handle& ids) {
+  void set_active_faces(const ArrayLike& ids) {
     const std::vector<int> f = indices(ids, "ids");
     workers_.run([&] { det_->set_active_faces(f); });
   }
   void clear_active() {
     workers_.run([&] { det_->clear_active_faces(); });
   }
-  void rebuild(const py::handle& V) {
+  void rebuild(const ArrayLike& V) {
     const Positions a = positions(V, "V");
     workers_.run([&] { det_->rebuild(a); });
   }
@@ -303,8 +303,8 @@ class PySelfDetector {
 
 class PyPairDetector {
  public:
-  PyPairDetector(const py::handle& Fa, const py::handle& Va, const py::handle& Fb,
-                 const py::handle& Vb, const std::string& bvh, const OptionArgs& args, int threads)
+  PyPairDetector(const ArrayLike& Fa, const ArrayLike& Va, const ArrayLike& Fb, const ArrayLike& Vb,
+                 const std::string& bvh, const OptionArgs& args, int threads)
       : workers_(threads) {
     std::vector<Face> fa = faces(Fa, "F_a"), fb = faces(Fb, "F_b");
     const Positions a = positions(Va, "V_a"), b = positions(Vb, "V_b");
@@ -321,8 +321,8 @@ class PyPairDetector {
     }));
   }
 
-  PairResult detect(const py::handle& A0, const py::handle& A1, const py::handle& B0,
-                    const py::handle& B1) {
+  PairResult detect(const ArrayLike& A0, const ArrayLike& A1, const ArrayLike& B0,
+                    const ArrayLike& B1) {
     const Positions a0 = positions(A0, "Va0"), a1 = positions(A1, "Va1");
     const Positions b0 = positions(B0, "Vb0"), b1 = positions(B1, "Vb1");
     PairDetectResult r = workers_.run([&] { return det_->detect(a0, a1, b0, b1); });
@@ -413,9 +413,9 @@ the first frame). linked_vertices: optional (k, 2) vertex pairs that count as on
 seam): pairs joining them are not tested.)") +
                               kOptionsDoc)
                                  .c_str())
-      .def(py::init([](const py::handle& F, const py::handle& V, std::string policy,
+      .def(py::init([](const ArrayLike& F, const ArrayLike& V, std::string policy,
                        std::string culling, std::string bvh, double thickness, int threads,
-                       const py::handle& linked, bool np_filter, bool fast_path,
+                       const ArrayLike& linked, bool np_filter, bool fast_path,
                        double toi_tolerance, int distance_filter_depth, double reuse_distance) {
              OptionArgs a{policy,         culling,   thickness, toi_tolerance,
                           reuse_distance, np_filter, fast_path, distance_filter_depth};
@@ -477,8 +477,8 @@ PairDetector(F_a, V_a, F_b, V_b, *, policy="proposed", culling="none", bvh="spat
 V_a, V_b: (n, 3) reference positions the trees are split on.)") +
                               kOptionsDoc)
                                  .c_str())
-      .def(py::init([](const py::handle& Fa, const py::handle& Va, const py::handle& Fb,
-                       const py::handle& Vb, std::string policy, std::string culling,
+      .def(py::init([](const ArrayLike& Fa, const ArrayLike& Va, const ArrayLike& Fb,
+                       const ArrayLike& Vb, std::string policy, std::string culling,
                        std::string bvh, double thickness, int threads, bool np_filter,
                        bool fast_path, double toi_tolerance, int distance_filter_depth) {
              OptionArgs a{policy,       culling,   thickness, toi_tolerance,
@@ -520,7 +520,7 @@ V_a, V_b: (n, 3) reference positions the trees are split on.)") +
       "A strip, twisted and coiled so that its ends cross.");
   proc.def(
       "smooth_perturbation",
-      [](const py::handle& V, double amplitude, double wavelength, std::uint64_t seed) {
+      [](const ArrayLike& V, double amplitude, double wavelength, std::uint64_t seed) {
         return matrix_array(smooth_perturbation(positions(V, "V"), amplitude, wavelength, seed));
       },
       py::arg("V"), py::arg("amplitude"), py::arg("wavelength"), py::arg("seed"),

@@ -31,7 +31,7 @@ fan-triangulated). Raises ValueError naming the file and line (or element) on ma
 
   m.def(
       "write_mesh",
-      [](const std::filesystem::path& path, const py::handle& V, const py::handle& F) {
+      [](const std::filesystem::path& path, const ArrayLike& V, const ArrayLike& F) {
         TriangleMesh mesh;
         const Positions v = positions(V, "V");
         if (v.cols() != 3) {
@@ -53,7 +53,7 @@ ValueError for non-finite coordinates, face ids out of range or a face repeating
 
   m.def(
       "mesh_edges",
-      [](const py::handle& F, std::optional<int> num_vertices) {
+      [](const ArrayLike& F, std::optional<int> num_vertices) {
         std::vector<Face> f = faces(F, "F");
         int n = 0;
         for (const Face& t : f)
