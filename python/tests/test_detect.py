@@ -219,3 +219,28 @@ def test_float32_and_lists_are_accepted():
     r1 = det.detect(np.asfortranarray(V0), np.asfortranarray(V1))
     r2 = det.detect(V0, V1)
     assert np.array_equal(r1.vf, r2.vf) and np.array_equal(r1.ee_toi, r2.ee_toi)
+
+
+def test_detect_releases_the_gil():
+    import threading
+    import time
+
+    F, V0, V1 = clothcd.procedural.crumpled_sheet(48, 2)
+    det = clothcd.SelfDetector(F, V0, culling="none", threads=1)
+    span = {}
+
+    def work():
+        span["start"] = time.perf_counter()
+        det.detect(V0, V1)
+        span["end"] = time.perf_counter()
+
+    worker = threading.Thread(target=work)
+    ticks = []
+    worker.start()
+    while worker.is_alive():
+        ticks.append(time.perf_counter())
+    worker.join()
+    # Had detect() kept the GIL, this thread could not have run while it was inside.
+    inside = [t for t in ticks if span["start"] < t < span["end"]]
+    assert span["end"] - span["start"] > 0.01
+    assert len(inside) > 0
