@@ -5,7 +5,8 @@
 
 Both sides build one detector with the same options, run one untimed detect(), then time `runs`
 detect() calls; the two alternate for `rounds` rounds. Prints each side's median over all timed
-runs and their ratio. Defaults: cloth_ball 92 -> 93 from $CLOTHCD_DATA (../shared/data), bvh
+runs, their ratio, and the median of the per-round ratios (robust to load that drifts between
+rounds on a shared machine). Defaults: cloth_ball 92 -> 93 from $CLOTHCD_DATA (../shared/data), bvh
 patch, culling sound, policy proposed, all cores.
 """
 
@@ -42,7 +43,7 @@ def main():
     V1, _ = clothcd.read_mesh(a.t1)
     det = clothcd.SelfDetector(F, V0, **opts)
     counts = None
-    cpp, py = [], []
+    cpp, py, ratios = [], [], []
     for _ in range(a.rounds):
         cmd = [str(tool), f"t0={a.t0}", f"t1={a.t1}", f"runs={a.runs}"] + [f"{k}={v}" for k, v in opts.items()]
         ref = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
@@ -52,13 +53,15 @@ def main():
             start = time.perf_counter()
             r = det.detect(V0, V1)
             py.append(time.perf_counter() - start)
+        ratios.append(statistics.median(py[-a.runs:]) / statistics.median(ref["seconds"]))
         counts = (len(r.vf), len(r.ee))
         assert counts == (ref["vf"], ref["ee"]), (counts, ref)
     mc, mp = statistics.median(cpp), statistics.median(py)
     print(f"{a.t0.name} -> {a.t1.name}, {opts}: {counts[0]} VF, {counts[1]} EE")
     print(f"C++ API  median {mc:.4f} s over {len(cpp)} runs: {' '.join(f'{x:.3f}' for x in cpp)}")
     print(f"Python   median {mp:.4f} s over {len(py)} runs: {' '.join(f'{x:.3f}' for x in py)}")
-    print(f"Python / C++ = {mp / mc:.3f}")
+    print(f"Python / C++ = {mp / mc:.3f}; per round: {' '.join(f'{x:.3f}' for x in ratios)}, "
+          f"median {statistics.median(ratios):.3f}")
 
 
 if __name__ == "__main__":
