@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The project's test command. Installs what is missing, builds the Release tree and runs its
-# ctest suites (labels unit, data, slow, install, cli) plus the format check, printing the wall
+# ctest suites (labels unit, data, slow, install, cli, python) plus the format check, printing the wall
 # time of each stage and how many tests ran and skipped.
 #   --full  also runs the minutes-long property sweeps (label sweep), builds the benchmarks and a
 #           clang tree with AddressSanitizer + UndefinedBehaviorSanitizer, runs the unit tests
@@ -65,7 +65,7 @@ stage "Release build"
 bench=OFF
 [ "$full" = 1 ] && bench=ON
 cmake -S . -B build/release -DCMAKE_BUILD_TYPE=Release -DCLOTHCD_BUILD_TESTS=ON \
-  -DCLOTHCD_BUILD_APPS=ON -DCLOTHCD_BUILD_BENCH=$bench >/dev/null
+  -DCLOTHCD_BUILD_APPS=ON -DCLOTHCD_BUILD_BENCH=$bench -DCLOTHCD_PYTHON=ON >/dev/null
 cmake --build build/release -j "$jobs"
 cmake --build build/release --target format-check
 
