@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The project's test command. Installs what is missing, builds the Release tree and runs its
-# ctest suites (labels unit, data, slow, install, cli, python) plus the format check, printing the wall
-# time of each stage and how many tests ran and skipped.
+# ctest suites (labels unit, data, slow, install, cli, python) plus the format check, printing
+# the wall time of each stage and how many tests ran and skipped.
 #   --full  also runs the minutes-long property sweeps (label sweep), builds the benchmarks and a
 #           clang tree with AddressSanitizer + UndefinedBehaviorSanitizer, runs the unit tests
 #           again there and fuzzes each libFuzzer target for a fixed number of runs from a fixed
