@@ -15,6 +15,8 @@
 #include <span>
 #include <vector>
 
+#include "contour.hpp"
+
 namespace clothcd::detail {
 
 // Relative rounding allowance of the short distance expressions below (a few ulps of the
@@ -92,35 +94,10 @@ template <class Vec>
     const int a = (i + n - 1) % n, c = (i + 1) % n;
     if (!clear(a, i, c) || !clear(c, a, i)) return false;
   }
-  struct Box {
-    Eigen::Vector2d lo, hi;
-    int edge;
-  };
-  std::vector<Box> boxes(n);
-  for (int i = 0; i < n; ++i) {
-    const int j = (i + 1) % n;
-    Box& b = boxes[i];
-    b.lo = p0[i].cwiseMin(p1[i]).cwiseMin(p0[j]).cwiseMin(p1[j]).array() - need;
-    b.hi = p0[i].cwiseMax(p1[i]).cwiseMax(p0[j]).cwiseMax(p1[j]).array() + need;
-    b.edge = i;
-  }
-  std::sort(boxes.begin(), boxes.end(), [](const Box& x, const Box& y) {
-    return x.lo[0] < y.lo[0] || (x.lo[0] == y.lo[0] && x.edge < y.edge);
+  return for_each_near_edge_pair(p0, p1, need, [&](int i, int j) {
+    const int i2 = (i + 1) % n, j2 = (j + 1) % n;
+    return clear(i, j, j2) && clear(i2, j, j2) && clear(j, i, i2) && clear(j2, i, i2);
   });
-  for (int k = 0; k < n; ++k) {
-    const Box& bi = boxes[k];
-    for (int m = k + 1; m < n && boxes[m].lo[0] <= bi.hi[0]; ++m) {
-      const Box& bj = boxes[m];
-      if (bj.lo[1] > bi.hi[1] || bi.lo[1] > bj.hi[1]) continue;
-      const int i = bi.edge, j = bj.edge;
-      if ((i + 1) % n == j || (j + 1) % n == i) continue;  // consecutive: checked above
-      const int i2 = (i + 1) % n, j2 = (j + 1) % n;
-      if (!clear(i, j, j2) || !clear(i2, j, j2) || !clear(j, i, i2) || !clear(j2, i, i2)) {
-        return false;
-      }
-    }
-  }
-  return true;
 }
 
 }  // namespace clothcd::detail

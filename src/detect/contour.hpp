@@ -71,6 +71,42 @@ inline Quadratic det_quadratic(const Eigen::Vector3d& x0, const Eigen::Vector3d&
           kRel * (nx0 * ny0 + nx0 * ny1 + nx1 * ny0 + nx1 * ny1)};
 }
 
+/// Calls pair(i, j) for every two non-consecutive edges of a closed loop (edge i runs from
+/// position i to i + 1) whose swept 2-D boxes, grown by `margin`, overlap, and returns false as
+/// soon as a call does. p0, p1: the loop's projected positions at t = 0 and t = 1; the hull of an
+/// edge's positions over [0, 1] lies in the box of its four endpoint positions.
+template <class Pair>
+bool for_each_near_edge_pair(std::span<const Eigen::Vector2d> p0,
+                             std::span<const Eigen::Vector2d> p1, double margin, Pair&& pair) {
+  const int n = static_cast<int>(p0.size());
+  struct Box {
+    Eigen::Vector2d lo, hi;
+    int edge;
+  };
+  std::vector<Box> boxes(n);
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    Box& b = boxes[i];
+    b.lo = p0[i].cwiseMin(p1[i]).cwiseMin(p0[j]).cwiseMin(p1[j]).array() - margin;
+    b.hi = p0[i].cwiseMax(p1[i]).cwiseMax(p0[j]).cwiseMax(p1[j]).array() + margin;
+    b.edge = i;
+  }
+  std::sort(boxes.begin(), boxes.end(), [](const Box& x, const Box& y) {
+    return x.lo[0] < y.lo[0] || (x.lo[0] == y.lo[0] && x.edge < y.edge);
+  });
+  for (int k = 0; k < n; ++k) {
+    const Box& bi = boxes[k];
+    for (int m = k + 1; m < n && boxes[m].lo[0] <= bi.hi[0]; ++m) {
+      const Box& bj = boxes[m];
+      if (bj.lo[1] > bi.hi[1] || bi.lo[1] > bj.hi[1]) continue;
+      const int i = bi.edge, j = bj.edge;
+      if ((i + 1) % n == j || (j + 1) % n == i) continue;  // consecutive: the caller's own check
+      if (!pair(i, j)) return false;
+    }
+  }
+  return true;
+}
+
 /// The general contour test (docs/algorithms.md 1.5): the loop, projected along the unit
 /// `axis`, is a simple closed curve with positive area for every t in [0, 1]. With a cone below
 /// pi/2 every projected triangle is positively oriented, so the number of preimages of a point is
@@ -115,50 +151,22 @@ inline bool contour_simple(std::span<const int> loop, std::span<const Eigen::Vec
   }
   if (!(area > 1e-12 * n * extent * extent)) return false;
 
-  // Swept 2-D boxes of the edges (the hull of an edge's positions over [0, 1] lies in the box of
-  // its four endpoint positions), grown by a rounding margin.
-  struct Box {
-    Eigen::Vector2d lo, hi;
-    int edge;
-  };
-  const double margin = 1e-12 * scale + 1e-300;
-  std::vector<Box> boxes(n);
+  std::vector<Eigen::Vector2d> p0(n), p1(n);
   for (int i = 0; i < n; ++i) {
-    const int a = loop[i], b = loop[(i + 1) % n];
-    const std::array<Eigen::Vector2d, 4> p{proj(v0[a]), proj(v1[a]), proj(v0[b]), proj(v1[b])};
-    Box& bx = boxes[i];
-    bx.lo = p[0];
-    bx.hi = p[0];
-    for (const auto& q : p) {
-      bx.lo = bx.lo.cwiseMin(q);
-      bx.hi = bx.hi.cwiseMax(q);
-    }
-    bx.lo.array() -= margin;
-    bx.hi.array() += margin;
-    bx.edge = i;
+    p0[i] = proj(v0[loop[i]]);
+    p1[i] = proj(v1[loop[i]]);
   }
-  std::sort(boxes.begin(), boxes.end(), [](const Box& x, const Box& y) {
-    return x.lo[0] < y.lo[0] || (x.lo[0] == y.lo[0] && x.edge < y.edge);
-  });
   // Orientation of endpoint q against edge (r, s) over [0, 1].
   auto orient = [&](int r, int s, int q) {
     return det_quadratic(v0[s] - v0[r], v1[s] - v1[r], v0[q] - v0[r], v1[q] - v1[r], axis).sign();
   };
-  for (int k = 0; k < n; ++k) {
-    const Box& bi = boxes[k];
-    for (int m = k + 1; m < n && boxes[m].lo[0] <= bi.hi[0]; ++m) {
-      const Box& bj = boxes[m];
-      if (bj.lo[1] > bi.hi[1] || bi.lo[1] > bj.hi[1]) continue;
-      const int i = bi.edge, j = bj.edge;
-      if ((i + 1) % n == j || (j + 1) % n == i) continue;  // consecutive: checked above
-      const int p = loop[i], q = loop[(i + 1) % n], r = loop[j], s = loop[(j + 1) % n];
-      const int op = orient(r, s, p), oq = orient(r, s, q), orr = orient(p, q, r),
-                os = orient(p, q, s);
-      if (op == 0 || oq == 0 || orr == 0 || os == 0) return false;
-      if (op != oq && orr != os) return false;  // the segments cross
-    }
-  }
-  return true;
+  return for_each_near_edge_pair(p0, p1, 1e-12 * scale + 1e-300, [&](int i, int j) {
+    const int p = loop[i], q = loop[(i + 1) % n], r = loop[j], s = loop[(j + 1) % n];
+    const int op = orient(r, s, p), oq = orient(r, s, q), orr = orient(p, q, r),
+              os = orient(p, q, s);
+    if (op == 0 || oq == 0 || orr == 0 || os == 0) return false;
+    return !(op != oq && orr != os);  // false where the segments cross
+  });
 }
 
 }  // namespace clothcd::detail
