@@ -293,8 +293,7 @@ const bool registered = clothcd::app::register_command(
       sub.add_flag("--verify", a->verify, "also run culling none and report missed collisions");
       sub.add_flag("--table", a->table,
                    "print a table of every BVH build, culling mode and cone policy instead");
-      sub.add_flag("--table-optimal", a->table_optimal,
-                   "include the OPTIMAL policy in --table (slow: minutes per refit on garments)");
+      sub.add_flag("--table-optimal", a->table_optimal, "include the OPTIMAL policy in --table");
       sub.add_option("--json", a->json, "write collisions and statistics to this JSON file");
       return [a] { return run(*a); };
     });

@@ -171,7 +171,7 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
     if (p == ConePolicy::Optimal) {
       throw InputError(
           "OPTIMAL is measured for the spread angles only (--optimal-every), not as "
-          "a detection policy: its refit takes seconds per step");
+          "a detection policy");
     }
   }
   const fs::path dir = opt.out / "runs" / seq.name;

@@ -30,7 +30,7 @@ enum class ConePolicy {
   Provot,    ///< C_Tang leaves, M_Provot merges (the paper's PROVOT)
   Proposed,  ///< C_Proposed leaves, M_Proposed merges (the paper's PROPOSED)
   Exact,     ///< exact leaf caps, M_Proposed merges (ours)
-  Optimal,   ///< optimal cone of every descendant leaf's control directions (slow reference)
+  Optimal,   ///< optimal cone of every descendant leaf's control directions (reference)
 };
 
 /// One node: 64 bytes. Leaves hold exactly one triangle, prim_ids()[first].
