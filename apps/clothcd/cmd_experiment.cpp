@@ -1,7 +1,8 @@
 // `clothcd experiment --scene S ... --out DIR`: every cone policy x culling rule x BVH build over
 // the same recorded frames; writes steps.csv, table1.md, table2.md, misses.md, spread.md,
 // summary.md and the figures fig5.png / fig6.png (scripts/plot_experiment.py with Debian's
-// python3-matplotlib).
+// python3-matplotlib). `clothcd experiment --in-situ SCENE.json... --frames N`: the self CCD's
+// culling settings inside the simulator instead (in_situ.cpp).
 #include <fmt/format.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
@@ -18,6 +19,7 @@
 #include "clothcd/core/error.hpp"
 #include "clothcd/experiment/experiment.hpp"
 #include "command.hpp"
+#include "in_situ.hpp"
 
 namespace {
 
@@ -39,6 +41,8 @@ struct Args {
   std::string python = "/usr/bin/python3";
   std::string plot_script;
   std::string scenes_dir;
+  std::vector<std::string> in_situ;
+  int frames = 6;
 };
 
 // The source tree (scenes/, scripts/): where the tool was built from, else the working folder.
@@ -256,14 +260,23 @@ const bool registered = clothcd::app::register_command(
     "tables and figures",
     [](CLI::App& sub) {
       auto a = std::make_shared<Args>();
-      sub.add_option("--scene", a->scenes,
-                     "folder of frames, scene name (scenes/NAME.json, simulated into "
-                     "OUT/frames/NAME), scene .json file, cloth_ball, or a procedural sequence "
-                     "(fold, stacked_sheets, winding_strip, crumpled_sheet, twisted_strip); "
-                     "NAME@N: at most N "
-                     "CD calls for that scene")
-          ->required();
-      sub.add_option("--out", a->out, "output folder (results found there are reused)")->required();
+      auto* scene =
+          sub.add_option("--scene", a->scenes,
+                         "folder of frames, scene name (scenes/NAME.json, simulated into "
+                         "OUT/frames/NAME), scene .json file, cloth_ball, or a procedural sequence "
+                         "(fold, stacked_sheets, winding_strip, crumpled_sheet, twisted_strip); "
+                         "NAME@N: at most N "
+                         "CD calls for that scene");
+      sub.add_option("--out", a->out,
+                     "output folder (results found there are reused); with --in-situ the "
+                     "Markdown file or its folder (default docs/results/in_situ.md)");
+      sub.add_option("--in-situ", a->in_situ,
+                     "instead: simulate these scene files under no culling and the sound culling "
+                     "with PROVOT, PROPOSED and EXACT cones, frame by frame in turn, check the "
+                     "frames are identical and compare the self CCD's figures")
+          ->excludes(scene);
+      sub.add_option("--frames", a->frames, "frames per scene with --in-situ (default 6)")
+          ->check(CLI::PositiveNumber);
       sub.add_option("--steps", a->steps, "at most this many CD calls (frame pairs) per scene")
           ->check(CLI::PositiveNumber);
       sub.add_option("--policies", a->policies, "cone policies: provot proposed exact");
@@ -283,7 +296,25 @@ const bool registered = clothcd::app::register_command(
       sub.add_option("--plot-script", a->plot_script,
                      "plot script (default: scripts/plot_experiment.py of the source tree)");
       sub.add_option("--scenes-dir", a->scenes_dir, "folder of scene files (default: scenes/)");
-      return [a] { return run(*a); };
+      return [a] {
+        if (!a->in_situ.empty()) {
+          clothcd::app::InSituArgs in;
+          in.scenes = a->in_situ;
+          in.frames = a->frames;
+          in.out = a->out;
+          in.threads = a->threads;
+          in.command = "clothcd experiment --in-situ";
+          for (const auto& s : a->in_situ)
+            in.command += " " + s;
+          in.command += fmt::format(" --frames {}", a->frames);
+          if (a->threads > 0) in.command += fmt::format(" --threads {}", a->threads);
+          if (!a->out.empty()) in.command += " --out " + a->out;
+          return clothcd::app::run_in_situ(in);
+        }
+        if (a->scenes.empty()) throw InputError("experiment: --scene or --in-situ is required");
+        if (a->out.empty()) throw InputError("experiment: --out is required with --scene");
+        return run(*a);
+      };
     });
 
 }  // namespace

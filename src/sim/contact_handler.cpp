@@ -4,6 +4,7 @@
 #include "clothcd/sim/contact_handler.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "sim/contact/ccd_hits.hpp"
 #include "sim/contact/crossings.hpp"
@@ -108,6 +109,32 @@ void ContactHandler::contact_couplings(std::vector<ContactCoupling>& out) const 
 
 void ContactHandler::contact_constraints(std::vector<ContactConstraint>& out) const {
   out = impl_->proximity.constraints();
+}
+
+SelfCcdFigures& SelfCcdFigures::operator+=(const SelfCcdFigures& o) {
+  calls += o.calls;
+  triangle_pairs += o.triangle_pairs;
+  nodes_culled += o.nodes_culled;
+  refit_s += o.refit_s;
+  traversal_s += o.traversal_s;
+  narrow_s += o.narrow_s;
+  return *this;
+}
+
+SelfProximityFigures& SelfProximityFigures::operator+=(const SelfProximityFigures& o) {
+  calls += o.calls;
+  reused_pairs += o.reused_pairs;
+  pairs += o.pairs;
+  query_s += o.query_s;
+  return *this;
+}
+
+SelfCcdFigures ContactHandler::take_self_ccd_figures() {
+  return std::exchange(impl_->detectors.self_ccd_figures, {});
+}
+
+SelfProximityFigures ContactHandler::take_self_proximity_figures() {
+  return std::exchange(impl_->detectors.self_proximity_figures, {});
 }
 
 CollisionStats ContactHandler::respond(const SubstepContext& ctx, std::span<Vec3> v_star) {

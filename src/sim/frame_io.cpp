@@ -261,7 +261,19 @@ nlohmann::json to_json(const FrameStats& s) {
            s.self_intersections >= 0 ? nlohmann::json(s.self_intersections) : nlohmann::json()},
           {"body_intersections",
            s.body_intersections >= 0 ? nlohmann::json(s.body_intersections) : nlohmann::json()},
-          {"intersection_seconds", s.intersection_seconds}};
+          {"intersection_seconds", s.intersection_seconds},
+          {"self_ccd",
+           {{"calls", s.self_ccd.calls},
+            {"triangle_pairs", s.self_ccd.triangle_pairs},
+            {"nodes_culled", s.self_ccd.nodes_culled},
+            {"refit_s", s.self_ccd.refit_s},
+            {"traversal_s", s.self_ccd.traversal_s},
+            {"narrow_s", s.self_ccd.narrow_s}}},
+          {"self_proximity",
+           {{"calls", s.self_proximity.calls},
+            {"reused_pairs", s.self_proximity.reused_pairs},
+            {"pairs", s.self_proximity.pairs},
+            {"query_s", s.self_proximity.query_s}}}};
 }
 
 std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {

@@ -82,6 +82,10 @@ FrameStats Simulation::advance_frame() {
     fs.unresolved += st.collision.unresolved;
     fs.excluded += st.collision.excluded;
   }
+  if (contact_) {
+    fs.self_ccd = contact_->take_self_ccd_figures();
+    fs.self_proximity = contact_->take_self_proximity_figures();
+  }
   state_.time = t1;
   ++frame_;
   fs.frame = frame_;

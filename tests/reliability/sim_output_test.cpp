@@ -54,10 +54,13 @@ std::string state_file(int k) {
   return name;
 }
 
-// The manifest without its wall-clock figures.
+// The manifest without its wall-clock figures, and without the self detector's figures: besides
+// their times, their counts depend on the detector's history (its tree and the pairs it keeps),
+// which a resumed run starts afresh.
 nlohmann::json without_times(nlohmann::json j) {
   for (auto& f : j["frames"]) {
-    for (const char* k : {"seconds", "collision_seconds", "intersection_seconds"})
+    for (const char* k :
+         {"seconds", "collision_seconds", "intersection_seconds", "self_ccd", "self_proximity"})
       f.erase(k);
   }
   return j;

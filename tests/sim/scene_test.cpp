@@ -52,6 +52,23 @@ TEST(Scene, ZoneMotionIsAffineUnlessTheSceneSaysRigid) {
   EXPECT_FALSE(parse_scene(j, "test-scene.json").contact.affine_zones);
 }
 
+TEST(Scene, SelfCcdCullsSoundlyWithProposedConesUnlessTheSceneSaysOtherwise) {
+  json j = small_grid_scene();
+  const Scene s = parse_scene(j, "test-scene.json");
+  EXPECT_EQ(s.contact.culling, Culling::Sound);
+  EXPECT_EQ(s.contact.cone_policy, ConePolicy::Proposed);
+  j["collisions"] = {{"culling", "none"}, {"cone_policy", "provot"}};
+  const Scene none = parse_scene(j, "test-scene.json");
+  EXPECT_EQ(none.contact.culling, Culling::None);
+  EXPECT_EQ(none.contact.cone_policy, ConePolicy::Provot);
+  j["collisions"] = {{"culling", "sound"}, {"cone_policy", "exact"}};
+  const Scene exact = parse_scene(j, "test-scene.json");
+  EXPECT_EQ(exact.contact.culling, Culling::Sound);
+  EXPECT_EQ(exact.contact.cone_policy, ConePolicy::Exact);
+  j["collisions"] = {{"cone_policy", "proposed"}};
+  EXPECT_EQ(parse_scene(j, "test-scene.json").contact.cone_policy, ConePolicy::Proposed);
+}
+
 TEST(Scene, UnresolvedHitsHalveTheSubstepUnlessTheSceneSaysNot) {
   json j = small_grid_scene();
   EXPECT_TRUE(parse_scene(j, "test-scene.json").solver.halve_unresolved);
@@ -199,6 +216,21 @@ TEST(Scene, ValidationErrorsNameFileAndKey) {
          j["collisions"] = {{"zone_motion", "bent"}};
        },
        "'collisions.zone_motion': 'bent' is not one of"},
+      {"unsound culling",
+       [](json& j) {
+         j["collisions"] = {{"culling", "cone"}};
+       },
+       "'collisions.culling': 'cone' is not one of"},
+      {"culling not a string",
+       [](json& j) {
+         j["collisions"] = {{"culling", true}};
+       },
+       "'collisions.culling': expected a string"},
+      {"bad cone policy",
+       [](json& j) {
+         j["collisions"] = {{"cone_policy", "optimal"}};
+       },
+       "'collisions.cone_policy': 'optimal' is not one of"},
       {"frames without placeholder",
        [](json& j) {
          j["body"] = {{"type", "frames"}, {"frames", "x.obj"}, {"count", 2}};

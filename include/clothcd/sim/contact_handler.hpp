@@ -5,14 +5,15 @@
 /// hits accumulate as linearized constraints that projected Gauss-Seidel satisfies together
 /// (inelastic projection, Harmon et al. 2008; the impulses are those of Bridson, Fedkiw,
 /// Anderson 2002), then rigid impact zones (Provot 1997) as the fail-safe. Cloth self contact
-/// goes through clothcd::SelfDetector (sound culling only), cloth-body contact through clothcd
-/// BVHs of both meshes and the conservative CCD kernels. Body vertices have infinite mass, and so
-/// have pinned cloth vertices. Processing is sequential over sorted pairs, so results do not
-/// depend on the thread count.
+/// goes through clothcd::SelfDetector (no culling, or the sound culling), cloth-body contact
+/// through clothcd BVHs of both meshes and the conservative CCD kernels. Body vertices have
+/// infinite mass, and so have pinned cloth vertices. Processing is sequential over sorted pairs, so
+/// results do not depend on the thread count.
 
 #include <memory>
 #include <span>
 
+#include "clothcd/detect/types.hpp"
 #include "clothcd/sim/cloth_model.hpp"
 #include "clothcd/sim/collision.hpp"
 
@@ -81,6 +82,39 @@ struct ContactOptions {
   /// later rounds demand only no contact, so a zone that keeps every pair apart but cannot
   /// restore the margin (cloth held between two body points that move differently) is accepted.
   int margin_rounds = 5;
+  /// Node culling of the self CCD: Culling::Sound (the default) or Culling::None; the unsound
+  /// cone rules are refused by the scene parser. Both find the same pairs, so the motion is
+  /// bitwise the same (tested); only the time and the figures of SelfCcdFigures differ.
+  Culling culling = Culling::Sound;
+  /// The normal cones the sound culling uses (no effect without culling): Provot, Proposed or
+  /// Exact. Again only the time and the figures change, never the motion.
+  ConePolicy cone_policy = ConePolicy::Proposed;
+};
+
+/// What the self detector's full CCD passes cost, summed over calls: the passes that test every
+/// pair (the first of a substep, and any unrestricted later one), not the restricted passes that
+/// test only pairs with a vertex the response moved. Counts follow from the motion and the
+/// detector's history (its tree, built on the first substep it saw): they do not depend on the
+/// thread count, but a run resumed from a saved state has a fresh detector and so other counts.
+struct SelfCcdFigures {
+  long long calls = 0;
+  long long triangle_pairs = 0;  ///< DetectStats::triangle_pairs
+  long long nodes_culled = 0;    ///< DetectStats::nodes_culled
+  double refit_s = 0.0;          ///< DetectStats::time_refit (boxes and cones)
+  double traversal_s = 0.0;      ///< DetectStats::time_traverse
+  double narrow_s = 0.0;         ///< DetectStats::time_narrow
+  SelfCcdFigures& operator+=(const SelfCcdFigures& o);
+};
+
+/// What the self proximity queries (at the repulsion distance, one per substep) cost, summed
+/// over calls. The detector reports no traversal figures for them, so these are what the
+/// contact stage sees: the pairs taken over from the last CCD pass and the pairs found.
+struct SelfProximityFigures {
+  long long calls = 0;
+  long long reused_pairs = 0;  ///< ProximityResult::reused_pairs
+  long long pairs = 0;         ///< VF and EE pairs found within the thickness
+  double query_s = 0.0;        ///< wall time of the queries
+  SelfProximityFigures& operator+=(const SelfProximityFigures& o);
 };
 
 class ContactHandler final : public CollisionHandler {
@@ -95,6 +129,9 @@ class ContactHandler final : public CollisionHandler {
   CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v_star) override;
 
   [[nodiscard]] const ContactOptions& options() const { return options_; }
+  /// The self detector's figures since the last call (zero without self contact); resets them.
+  SelfCcdFigures take_self_ccd_figures();
+  SelfProximityFigures take_self_proximity_figures();
 
  private:
   struct Impl;

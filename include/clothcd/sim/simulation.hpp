@@ -38,6 +38,10 @@ struct FrameStats {
   int zone_rounds = 0;
   long long unresolved = 0;  ///< CCD hits left when zone rounds ran out
   long long excluded = 0;    ///< CCD hits left out because their triangles already crossed
+  /// The self detector's full CCD passes and proximity queries of the frame (see
+  /// SelfCcdFigures: counts depend on the run's history, so a resumed run's may differ).
+  SelfCcdFigures self_ccd;
+  SelfProximityFigures self_proximity;
   /// Intersecting triangle pairs at the frame's end (-1: not counted).
   long long self_intersections = -1;
   long long body_intersections = -1;

@@ -105,7 +105,16 @@ void CcdHits::self_hits(const Positions& x1m, std::span<const Vec3> x1, std::spa
     det.clear_active_faces();
   }
   const DetectResult r = det.detect(g_.x0m, x1m);
-  if (active == nullptr) det_.self_pass_done();
+  if (active == nullptr) {
+    det_.self_pass_done();
+    SelfCcdFigures& f = det_.self_ccd_figures;
+    ++f.calls;
+    f.triangle_pairs += static_cast<long long>(r.stats.triangle_pairs);
+    f.nodes_culled += static_cast<long long>(r.stats.nodes_culled);
+    f.refit_s += r.stats.time_refit;
+    f.traversal_s += r.stats.time_traverse;
+    f.narrow_s += r.stats.time_narrow;
+  }
   // Each hit in parallel; the contacts are then gathered in the detector's sorted order.
   const auto& faces = g_.cloth().faces();
   const auto& edges = g_.cloth().edges();

@@ -16,7 +16,9 @@ DetectOptions ccd_detect_options(const ContactOptions& o) {
 SelfDetector& ContactDetectors::start_self(const ContactGeometry& g) {
   if (!self_) {
     DetectOptions o = ccd_detect_options(opt_);
-    o.culling = Culling::Sound;  // never the unsound cone rules in the simulator
+    // Never the unsound cone rules in the simulator: None or Sound find the same pairs.
+    o.culling = opt_.culling == Culling::None ? Culling::None : Culling::Sound;
+    o.policy = opt_.cone_policy;
     // The proximity query (at the repulsion distance) then reuses the last CCD pass's pairs.
     o.reuse_distance = opt_.thickness;
     // Seam-linked vertices count as one point: the seam's sides touch by design.

@@ -30,6 +30,10 @@ class ContactDetectors {
   /// the start when either has loosened past its fit after the last build.
   void body_proximity_done(const ContactGeometry& g);
 
+  /// Figures of the self detector since ContactHandler last took them.
+  SelfCcdFigures self_ccd_figures;
+  SelfProximityFigures self_proximity_figures;
+
  private:
   const ClothModel& model_;
   const ContactOptions& opt_;

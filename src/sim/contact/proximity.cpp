@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 
 namespace clothcd::sim::detail {
@@ -14,7 +15,14 @@ void ProximityContacts::find(ContactDetectors& detectors, const Escapes& escapes
   couplings_.clear();
   const std::span<const Vec3> none;
   if (self) {
-    const ProximityResult r = detectors.start_self(g_).proximity(g_.x0m, opt_.thickness);
+    SelfDetector& det = detectors.start_self(g_);
+    const auto t = std::chrono::steady_clock::now();
+    const ProximityResult r = det.proximity(g_.x0m, opt_.thickness);
+    SelfProximityFigures& f = detectors.self_proximity_figures;
+    f.query_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+    ++f.calls;
+    f.reused_pairs += static_cast<long long>(r.reused_pairs);
+    f.pairs += static_cast<long long>(r.vf.size() + r.ee.size());
     for (const auto& p : r.vf) {
       if (g_.vf_linked(p.vertex, p.face)) continue;
       Contact c;

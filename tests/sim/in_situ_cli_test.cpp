@@ -1,0 +1,93 @@
+// `clothcd experiment --in-situ`: on a small swinging sheet, the report and the CSV hold every
+// setting's frames, the counts relate as the culling says (no culling culls nothing and tests the
+// most pairs; every setting runs the same full passes), and bad input writes nothing.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../reliability/cli_runner.hpp"
+
+namespace clothcd {
+namespace {
+
+using test::CliScratch;
+
+const char* kScene = R"({"name": "swing", "frames": 10, "frame_dt": 0.04,
+ "cloth": {"grid": {"origin": [-0.3, 0.22, -0.3], "u": [0.6, 0, 0], "v": [0, 0, 0.6],
+                    "resolution": [16, 16]}},
+ "body": {"type": "sphere", "center": [0, 0, 0], "radius": 0.2, "subdivisions": 2},
+ "collisions": {"self": true, "body": true, "thickness": 0.002},
+ "pins": [{"grid_edge": "u0"}]})";
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream ss(line);
+  for (std::string c; std::getline(ss, c, ',');)
+    cells.push_back(c);
+  return cells;
+}
+
+TEST(InSitu, ReportsEverySettingOnIdenticalFrames) {
+  CliScratch dir;
+  dir.write("s.json", kScene);
+  const auto r = dir.run("experiment --in-situ s.json --frames 3 --threads 1 --out res");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string md = CliScratch::slurp(dir / "res/in_situ.md");
+  for (const char* want : {"clothcd experiment --in-situ s.json --frames 3 --threads 1",
+                           "- commit: ", "- machine: ", "load average", "## swing", "| PROVOT |",
+                           "| PROPOSED |", "| EXACT |", "| none |", "0.75", "0.82"}) {
+    EXPECT_NE(md.find(want), std::string::npos) << want << "\n" << md;
+  }
+  std::stringstream csv(CliScratch::slurp(dir / "res/in_situ.csv"));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  const std::vector<std::string> head = split(line);
+  std::map<std::string, std::size_t> col;
+  for (std::size_t i = 0; i < head.size(); ++i)
+    col[head[i]] = i;
+  for (const char* c : {"setting", "frame", "self_ccd_calls", "triangle_pairs", "nodes_culled"})
+    ASSERT_TRUE(col.contains(c)) << c;
+  // frame -> setting -> cells
+  std::map<std::string, std::map<std::string, std::vector<std::string>>> rows;
+  while (std::getline(csv, line))
+    rows[split(line)[col["frame"]]][split(line)[col["setting"]]] = split(line);
+  ASSERT_EQ(rows.size(), 3u);
+  long long pairs_none = 0, pairs_sound = 0, culled = 0;
+  for (const auto& [frame, by] : rows) {
+    ASSERT_EQ(by.size(), 4u) << "frame " << frame;
+    const auto& none = by.at("none");
+    EXPECT_EQ(std::stoll(none[col["nodes_culled"]]), 0);
+    EXPECT_GT(std::stoll(none[col["self_ccd_calls"]]), 0);
+    for (const char* s : {"PROVOT", "PROPOSED", "EXACT"}) {
+      const auto& row = by.at(s);
+      EXPECT_EQ(row[col["self_ccd_calls"]], none[col["self_ccd_calls"]]) << s << " " << frame;
+      EXPECT_LE(std::stoll(row[col["triangle_pairs"]]), std::stoll(none[col["triangle_pairs"]]))
+          << s << " " << frame;
+      pairs_sound += std::stoll(row[col["triangle_pairs"]]);
+      culled += std::stoll(row[col["nodes_culled"]]);
+    }
+    pairs_none += 3 * std::stoll(none[col["triangle_pairs"]]);
+  }
+  EXPECT_GT(culled, 0);
+  EXPECT_LT(pairs_sound, pairs_none);
+}
+
+TEST(InSitu, BadInputWritesNothing) {
+  CliScratch dir;
+  const auto missing = dir.run("experiment --in-situ nope.json --frames 2 --out res");
+  EXPECT_NE(missing.code, 0);
+  EXPECT_NE(missing.err.find("nope.json"), std::string::npos) << missing.err;
+  // Without collisions there is nothing to compare: an error naming the file.
+  dir.write("plain.json", R"({"name": "plain", "frames": 2,
+    "cloth": {"grid": {"resolution": [4, 4]}}, "pins": [{"grid_edge": "u0"}]})");
+  const auto plain = dir.run("experiment --in-situ plain.json --frames 2 --out res");
+  EXPECT_NE(plain.code, 0);
+  EXPECT_NE(plain.err.find("plain.json"), std::string::npos) << plain.err;
+  EXPECT_EQ(dir.files(), std::vector<std::string>{"plain.json"});
+}
+
+}  // namespace
+}  // namespace clothcd
