@@ -89,9 +89,9 @@ if [ "$full" = 1 ]; then
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     CLOTHCD_DATA=$data run_ctest --test-dir build/asan -L unit
 
-  stage "Fuzzing (${CLOTHCD_FUZZ_RUNS:-20000} runs per target, seed 1)"
+  stage "Fuzzing (${CLOTHCD_FUZZ_RUNS:-5000} runs per target, seed 1)"
   scripts/fuzz.sh --build-dir build/asan --no-build --jobs "$jobs" --seed 1 \
-    --runs "${CLOTHCD_FUZZ_RUNS:-20000}"
+    --runs "${CLOTHCD_FUZZ_RUNS:-5000}"
 fi
 echo "== ${stage_name}: $((SECONDS - stage_start)) s"
 echo "== All tests passed in $((SECONDS - start)) s"
