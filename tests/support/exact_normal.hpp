@@ -23,7 +23,8 @@ inline std::optional<Eigen::Vector3d> exact_normal(const std::array<Eigen::Vecto
   const mpq_class s = 1 - t;
   std::array<std::array<mpq_class, 3>, 3> p;
   for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) p[i][j] = s * mpq_class(t0[i][j]) + t * mpq_class(t1[i][j]);
+    for (int j = 0; j < 3; ++j)
+      p[i][j] = s * mpq_class(t0[i][j]) + t * mpq_class(t1[i][j]);
   }
   std::array<mpq_class, 3> e1, e2;
   for (int j = 0; j < 3; ++j) {
