@@ -17,9 +17,12 @@ constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2;
 // Forward error bound of a computed cross product e1 x e2 of rounded edge differences: each edge
 // carries a relative error <= u (one subtraction), each component of the cross product
 // <= 4u (|x1 y2| + |x2 y1|), and the vector of those magnitudes is at most 2 |e1||e2| long.
-// A safety factor of two on top.
+// A safety factor of two on top. Products that fall below the normal range lose relative
+// precision: each rounds with an absolute error up to half the smallest subnormal, so a few of
+// those are added (a fuzzed step whose end normal had components of a few subnormals got a
+// cone that missed that normal by 1.6e-10 rad).
 double cross_error(double e1_len, double e2_len) {
-  return 16.0 * kUnitRoundoff * e1_len * e2_len;
+  return 16.0 * kUnitRoundoff * e1_len * e2_len + 8.0 * std::numeric_limits<double>::denorm_min();
 }
 
 // The angle by which a vector of length `len`, known to within `err`, may differ in direction

@@ -249,6 +249,21 @@ TEST(LeafCone, StepThroughTheOriginHoldsTheExactNormal) {
   expect_holds_exact_normal(m, 4096, "step through the origin");
 }
 
+// A fuzzed step whose end triangle has edges of 1e-12 and 1e-310: the end normal's components
+// are a few subnormals, whose products keep only a couple of bits. The cone's error bound, purely
+// relative, let the EXACT cone miss that normal by 1.6e-10 rad; it now adds the absolute rounding
+// of subnormal products.
+TEST(LeafCone, SubnormalEndNormalIsHeld) {
+  MovingTriangle m;
+  m.t0 = {Eigen::Vector3d(-0x1.16b725a440d6bp-300, -0x1.16b2ae2642928p-300, 0x1.19799812dea11p-40),
+          Eigen::Vector3d(0x0p+0, 0x1.acbd48f74511cp-41, 0x1.19799812dea11p-40),
+          Eigen::Vector3d(0x0p+0, 0x0p+0, 0x1.19799812dea11p-40)};
+  m.t1 = {Eigen::Vector3d(0x0.08ef1f461ed8cp-1022, 0x0.0000000008b85p-1022, 0x0p+0),
+          Eigen::Vector3d(0x0p+0, -0x1.19799812dea11p-40, 0x1.19799812dea11p-40),
+          Eigen::Vector3d(0x0p+0, 0x0p+0, 0x0p+0)};
+  expect_holds_exact_normal(m, 4096, "subnormal end normal");
+}
+
 TEST(LeafCone, CcdConeHoldsTheExactNormalOnAdversarialSteps) {
   int usable = 0;
   for (int seed = 0; seed < kCases / 50; ++seed) {
