@@ -32,7 +32,8 @@ stage() {
   echo "== ${stage_name}"
 }
 
-data=${CLOTHCD_DATA:-../shared/data}
+# Absolute: the tests run in their own build folders.
+data=$(realpath -m "${CLOTHCD_DATA:-../shared/data}")
 if [ -n "${CI:-}" ] && [ ! -d "$data" ]; then
   echo "test.sh: the shared data folder '$data' does not exist; CI runs the data tests, so set" \
     "CLOTHCD_DATA to the folder that holds cloth-ball/, ccd-queries/, body/ and garments/" >&2
