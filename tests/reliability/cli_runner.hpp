@@ -38,6 +38,8 @@ class CliScratch {
   ~CliScratch() {
     std::error_code ec;
     std::filesystem::remove_all(dir_, ec);
+    std::filesystem::remove(dir_.string() + ".stdout", ec);  // left by spawn() / wait()
+    std::filesystem::remove(dir_.string() + ".stderr", ec);
   }
   CliScratch(const CliScratch&) = delete;
   CliScratch& operator=(const CliScratch&) = delete;
