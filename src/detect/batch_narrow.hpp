@@ -26,8 +26,10 @@ class FeatureBatch {
 
   void add_vf(const FeatureContext& ctx, int v, int f, FeatureCounters& c,
               std::vector<VertexFaceCollision>& out) {
-    const Face& t = ctx.topo->faces()[f];
-    if (ctx.grouped(v, t[0]) || ctx.grouped(v, t[1]) || ctx.grouped(v, t[2])) return;
+    if (!ctx.links.empty()) {  // linked vertices are rare: test for them only when there are any
+      const Face& t = ctx.topo->faces()[f];
+      if (ctx.grouped(v, t[0]) || ctx.grouped(v, t[1]) || ctx.grouped(v, t[2])) return;
+    }
     vf_[nvf_++] = {v, f};
     if (nvf_ == kSize) flush_vf(ctx, c, out);
   }
@@ -35,11 +37,13 @@ class FeatureBatch {
   /// Edges ea < eb.
   void add_ee(const FeatureContext& ctx, int ea, int eb, FeatureCounters& c,
               std::vector<EdgeEdgeCollision>& out) {
-    const Edge& a = ctx.topo->edges()[ea];
-    const Edge& b = ctx.topo->edges()[eb];
-    if (ctx.grouped(a[0], b[0]) || ctx.grouped(a[0], b[1]) || ctx.grouped(a[1], b[0]) ||
-        ctx.grouped(a[1], b[1])) {
-      return;
+    if (!ctx.links.empty()) {
+      const Edge& a = ctx.topo->edges()[ea];
+      const Edge& b = ctx.topo->edges()[eb];
+      if (ctx.grouped(a[0], b[0]) || ctx.grouped(a[0], b[1]) || ctx.grouped(a[1], b[0]) ||
+          ctx.grouped(a[1], b[1])) {
+        return;
+      }
     }
     ee_[nee_++] = {ea, eb};
     if (nee_ == kSize) flush_ee(ctx, c, out);
