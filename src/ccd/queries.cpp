@@ -16,7 +16,6 @@
 #include "ccd/fast_path.hpp"
 #include "ccd/inclusion.hpp"
 #include "ccd/motion.hpp"
-#include "ccd/np_batch.hpp"
 
 namespace clothcd {
 
@@ -51,12 +50,11 @@ CcdResult from(const ccd_detail::InclusionOutcome& o, CcdPath path, std::uint32_
   return r;
 }
 
-// `filtered`: the caller already ran unscaled_np_filter on these points and it did not cull.
-CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points, const CcdOptions& opt,
-              bool filtered = false) {
+CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
+              const CcdOptions& opt) {
   check_options(opt);
   // Most pairs of a detection step end here: the NP filter without building the scaled motion.
-  if (!filtered && opt.fast_path && opt.thickness == 0 &&
+  if (opt.fast_path && opt.thickness == 0 &&
       ccd_detail::unscaled_np_filter(kind, points) == ccd_detail::NpVerdict::culled) {
     CcdResult r;
     r.path = CcdPath::np_culled;
@@ -115,18 +113,6 @@ CcdResult vertex_face_ccd(const VertexFaceQuery& q, const CcdOptions& opt) {
 CcdResult edge_edge_ccd(const EdgeEdgeQuery& q, const CcdOptions& opt) {
   return run(Kind::edge_edge, points_of(q), opt);
 }
-
-namespace ccd_detail {
-
-CcdResult vertex_face_ccd_unfiltered(const VertexFaceQuery& q, const CcdOptions& opt) {
-  return run(Kind::vertex_face, points_of(q), opt, true);
-}
-
-CcdResult edge_edge_ccd_unfiltered(const EdgeEdgeQuery& q, const CcdOptions& opt) {
-  return run(Kind::edge_edge, points_of(q), opt, true);
-}
-
-}  // namespace ccd_detail
 
 bool np_filter_culls(const VertexFaceQuery& q) {
   const auto verdict = ccd_detail::unscaled_np_filter(Kind::vertex_face, points_of(q));

@@ -11,7 +11,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "batch_narrow.hpp"
 #include "clearance.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "contour.hpp"
@@ -50,7 +49,6 @@ struct NarrowBuffer {
   detail::FeatureCounters c;
   std::vector<VertexFaceCollision> vf;
   std::vector<EdgeEdgeCollision> ee;
-  detail::FeatureBatch batch;
 };
 
 }  // namespace
@@ -231,22 +229,8 @@ struct SelfDetector::Impl {
     const bool wide = box_reach() > opt.thickness;
     if (near != nullptr) near->assign(pairs.size(), 0);
     const auto& faces = topo.faces();
-    // Feature pairs in blocks through the vector NP filter where the settings allow it.
-    const bool batched = detail::FeatureBatch::applies(ctx);
-    auto kvf = [&](int v, int f, NarrowBuffer& out) {
-      if (batched) {
-        out.batch.add_vf(ctx, v, f, out.c, out.vf);
-      } else {
-        ctx.kernel_vf(v, f, out.c, out.vf);
-      }
-    };
-    auto kee = [&](int a, int b, NarrowBuffer& out) {
-      if (batched) {
-        out.batch.add_ee(ctx, a, b, out.c, out.ee);
-      } else {
-        ctx.kernel_ee(a, b, out.c, out.ee);
-      }
-    };
+    auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
+    auto kee = [&](int a, int b, NarrowBuffer& out) { ctx.kernel_ee(a, b, out.c, out.ee); };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         NarrowBuffer& out = locals.local();
@@ -293,8 +277,6 @@ struct SelfDetector::Impl {
                           ctx.kernel_ee(ea, eb, out.c, out.ee);
                         }
                       });
-    for (auto& l : locals)
-      l.batch.flush(ctx, l.c, l.vf, l.ee);
     DetectStats& st = res.stats;
     st.triangle_pairs = 0;
     st.vf_orphans = orphans.vf.size();

@@ -17,7 +17,6 @@
 #include <vector>
 
 #include "ccd/face_bounds.hpp"
-#include "ccd/np_batch.hpp"
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/types.hpp"
@@ -160,32 +159,6 @@ struct FeatureContext {
                           v1[a[0]], v1[a[1]], v1[b[0]], v1[b[1]]};
     double toi = 1.0;
     if (ccd_hit(q, c.ee_tests, c.ee_np, toi)) out.push_back({ea, eb, a, b, toi});
-  }
-
-  /// kernel_vf for a pair already past its grouping test and the unscaled NP filter (uncut),
-  /// where FeatureBatch::applies: the kernel without repeating that filter.
-  void kernel_vf_unfiltered(int v, int f, FeatureCounters& c,
-                            std::vector<VertexFaceCollision>& out) const {
-    const Face& t = topo->faces()[f];
-    const VertexFaceQuery q{v0[v], v0[t[0]], v0[t[1]], v0[t[2]],
-                            v1[v], v1[t[0]], v1[t[1]], v1[t[2]]};
-    ++c.vf_tests;
-    const CcdResult r = ccd_detail::vertex_face_ccd_unfiltered(q, ccd);
-    c.vf_np += counted_np(r);
-    if (r.hit) out.push_back({v, f, t, r.toi});
-  }
-
-  /// kernel_ee likewise (edges ea < eb).
-  void kernel_ee_unfiltered(int ea, int eb, FeatureCounters& c,
-                            std::vector<EdgeEdgeCollision>& out) const {
-    const Edge& a = topo->edges()[ea];
-    const Edge& b = topo->edges()[eb];
-    const EdgeEdgeQuery q{v0[a[0]], v0[a[1]], v0[b[0]], v0[b[1]],
-                          v1[a[0]], v1[a[1]], v1[b[0]], v1[b[1]]};
-    ++c.ee_tests;
-    const CcdResult r = ccd_detail::edge_edge_ccd_unfiltered(q, ccd);
-    c.ee_np += counted_np(r);
-    if (r.hit) out.push_back({ea, eb, a, b, r.toi});
   }
 
   /// One feature query of any mesh or meshes through this context's filters and kernel: the NP
