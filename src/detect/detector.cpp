@@ -306,27 +306,35 @@ struct SelfDetector::Impl {
     const Face& tg = topo.faces()[g];
     const detail::Box& bf = ctx.fboxes[f];
     const detail::Box& bg = ctx.fboxes[g];
-    for (int v : tf) {
+    // Ownership: a set bit of first_mask settles it; otherwise the ordered search decides.
+    const unsigned mf = owner.first_mask(f), mg = owner.first_mask(g);
+    for (int k = 0; k < 3; ++k) {
+      const int v = tf[k];
       if (!detail::overlap(ctx.vboxes[v], bg)) continue;
-      if (!owner.owns_vf(v, g, f) || !vf_in_scope(v, g)) continue;
+      if (!((mf >> k) & 1u) && !owner.owns_vf(v, g, f)) continue;
+      if (!vf_in_scope(v, g)) continue;
       kvf(v, g, out);
     }
-    for (int v : tg) {
+    for (int k = 0; k < 3; ++k) {
+      const int v = tg[k];
       if (!detail::overlap(ctx.vboxes[v], bf)) continue;
-      if (!owner.owns_vf(v, f, g) || !vf_in_scope(v, f)) continue;
+      if (!((mg >> k) & 1u) && !owner.owns_vf(v, f, g)) continue;
+      if (!vf_in_scope(v, f)) continue;
       kvf(v, f, out);
     }
     const auto& ef = topo.face_edges(f);
     const auto& eg = topo.face_edges(g);
+    const detail::Box bg_edges[3] = {ctx.eboxes[eg[0]], ctx.eboxes[eg[1]], ctx.eboxes[eg[2]]};
     for (int i = 0; i < 3; ++i) {
       const detail::Box& ba = ctx.eboxes[ef[i]];
       if (!detail::overlap(ba, bg)) continue;  // edge of f misses all of g
       for (int j = 0; j < 3; ++j) {
-        if (!detail::overlap(ba, ctx.eboxes[eg[j]])) continue;
+        if (!detail::overlap(ba, bg_edges[j])) continue;
         const int ea = ef[i], eb = eg[j];
         const bool a_first = ea < eb;
         const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;
-        const bool mine = a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f);
+        const bool mine = ((mf >> (3 + i)) & (mg >> (3 + j)) & 1u) ||
+                          (a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f));
         if (!mine || !ee_in_scope(e1, e2)) continue;
         kee(e1, e2, out);
       }
