@@ -1,73 +1,16 @@
 // SelfDetector, PairDetector, their results and the procedural test scenes.
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cctype>
-#include <map>
 #include <optional>
 
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/detect/names.hpp"
 #include "clothcd/detect/procedural.hpp"
 
 namespace clothcd::python {
 namespace {
-
-template <class T>
-T pick(const char* what, std::string value, const std::map<std::string, T>& choices) {
-  std::transform(value.begin(), value.end(), value.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (const auto it = choices.find(value); it != choices.end()) return it->second;
-  std::string names;
-  for (const auto& [name, v] : choices)
-    names += (names.empty() ? "" : ", ") + name;
-  fail(fmt::format("{}: unknown value '{}' (one of {})", what, value, names));
-}
-
-ConePolicy policy_of(const std::string& s) {
-  return pick<ConePolicy>("policy", s,
-                          {{"provot", ConePolicy::Provot},
-                           {"proposed", ConePolicy::Proposed},
-                           {"exact", ConePolicy::Exact},
-                           {"optimal", ConePolicy::Optimal}});
-}
-Culling culling_of(const std::string& s) {
-  return pick<Culling>("culling", s,
-                       {{"none", Culling::None},
-                        {"cone", Culling::Cone},
-                        {"gated", Culling::Gated},
-                        {"sound", Culling::Sound}});
-}
-BvhBuild build_of(const std::string& s) {
-  return pick<BvhBuild>("bvh", s, {{"spatial", BvhBuild::Spatial}, {"patch", BvhBuild::Patch}});
-}
-const char* name_of(ConePolicy p) {
-  switch (p) {
-    case ConePolicy::Provot:
-      return "provot";
-    case ConePolicy::Proposed:
-      return "proposed";
-    case ConePolicy::Exact:
-      return "exact";
-    case ConePolicy::Optimal:
-      return "optimal";
-  }
-  return "?";
-}
-const char* name_of(Culling c) {
-  switch (c) {
-    case Culling::None:
-      return "none";
-    case Culling::Cone:
-      return "cone";
-    case Culling::Gated:
-      return "gated";
-    case Culling::Sound:
-      return "sound";
-  }
-  return "?";
-}
 
 // The options shared by both detectors' constructors; all keyword-only in Python.
 struct OptionArgs {
@@ -77,8 +20,8 @@ struct OptionArgs {
   std::optional<int> distance_filter_depth;
 
   void apply(DetectOptions& o) const {
-    if (policy) o.policy = policy_of(*policy);
-    if (culling) o.culling = culling_of(*culling);
+    if (policy) o.policy = parse_cone_policy(*policy, "policy");
+    if (culling) o.culling = parse_culling(*culling, "culling");
     if (thickness) {
       if (!(*thickness >= 0) || !std::isfinite(*thickness)) {
         fail(fmt::format("thickness must be finite and >= 0, got {}", *thickness));
@@ -95,8 +38,8 @@ struct OptionArgs {
 
 py::dict options_dict(const DetectOptions& o, const char* bvh) {
   py::dict d;
-  d["policy"] = name_of(o.policy);
-  d["culling"] = name_of(o.culling);
+  d["policy"] = std::string(to_string(o.policy));
+  d["culling"] = std::string(to_string(o.culling));
   d["bvh"] = bvh;
   d["thickness"] = o.thickness;
   d["np_filter"] = o.np_filter;
@@ -231,7 +174,7 @@ class PySelfDetector {
     std::vector<Face> f = faces(F, "F");
     const Positions v = positions(V, "V_rest");
     DetectOptions o;
-    o.build = build_of(bvh);
+    o.build = parse_bvh_build(bvh, "bvh");
     o.culling = Culling::Sound;
     args.apply(o);
     if (!linked.obj.is_none()) o.linked_vertices = index_pairs(linked, "linked_vertices");
@@ -309,7 +252,7 @@ class PyPairDetector {
     std::vector<Face> fa = faces(Fa, "F_a"), fb = faces(Fb, "F_b");
     const Positions a = positions(Va, "V_a"), b = positions(Vb, "V_b");
     DetectOptions o;
-    o.build = build_of(bvh);
+    o.build = parse_bvh_build(bvh, "bvh");
     args.apply(o);
     // The detector numbers edges as a Topology of the same faces does.
     const Topology ta(fa, static_cast<int>(a.rows())), tb(fb, static_cast<int>(b.rows()));
