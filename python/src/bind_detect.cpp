@@ -192,14 +192,18 @@ class PySelfDetector {
   }
 
   SelfResult detect(const ArrayLike& V0, const ArrayLike& V1) {
-    const Positions a = positions(V0, "V0"), b = positions(V1, "V1");
-    DetectResult r = workers_.run([&] { return det_->detect(a, b); });
+    const PointsArg a(V0, "V0"), b(V1, "V1");
+    DetectResult r = workers_.run([&] {
+      return with_points([&](const auto& x0, const auto& x1) { return det_->detect(x0, x1); }, a,
+                         b);
+    });
     return SelfResult(r);
   }
 
   ProximityOut proximity(const ArrayLike& V, double h) {
-    const Positions a = positions(V, "V");
-    ProximityResult r = workers_.run([&] { return det_->proximity(a, h); });
+    const PointsArg a(V, "V");
+    ProximityResult r = workers_.run(
+        [&] { return with_points([&](const auto& x) { return det_->proximity(x, h); }, a); });
     return ProximityOut(r);
   }
 
@@ -215,8 +219,8 @@ class PySelfDetector {
     workers_.run([&] { det_->clear_active_faces(); });
   }
   void rebuild(const ArrayLike& V) {
-    const Positions a = positions(V, "V");
-    workers_.run([&] { det_->rebuild(a); });
+    const PointsArg a(V, "V");
+    workers_.run([&] { with_points([&](const auto& x) { det_->rebuild(x); }, a); });
   }
   void set_options(const OptionArgs& args, std::optional<bool> verify) {
     DetectOptions o = det_->options();
@@ -266,9 +270,10 @@ class PyPairDetector {
 
   PairResult detect(const ArrayLike& A0, const ArrayLike& A1, const ArrayLike& B0,
                     const ArrayLike& B1) {
-    const Positions a0 = positions(A0, "Va0"), a1 = positions(A1, "Va1");
-    const Positions b0 = positions(B0, "Vb0"), b1 = positions(B1, "Vb1");
-    PairDetectResult r = workers_.run([&] { return det_->detect(a0, a1, b0, b1); });
+    const PointsArg a0(A0, "Va0"), a1(A1, "Va1"), b0(B0, "Vb0"), b1(B1, "Vb1");
+    PairDetectResult r = workers_.run([&] {
+      return with_points([&](const auto&... x) { return det_->detect(x...); }, a0, a1, b0, b1);
+    });
     return PairResult(r);
   }
 
