@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs bench/detect/scale_bench once per size, each in its own process (so that the peak memory is
-# that size's), under a 12 GiB address-space limit, and prints the markdown table of docs/detect.md
-# ("Scale") with the date and machine. A size that fails (e.g. out of memory) is a table row
+# that size's), under a 12 GiB address-space limit, and prints the markdown table of docs/results/scale.md
+# with the date and machine. A size that fails (e.g. out of memory) is a table row
 # saying so.
 # Usage: scripts/detect_scale_bench.sh [BUILD_DIR] [THREADS] [SIZES...]
 #   defaults: build/release, 2 threads, 10000 100000 1000000 4000000 triangles.

@@ -20,6 +20,7 @@
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/detect/names.hpp"
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/geometry/cone.hpp"
 #include "command.hpp"
@@ -261,9 +262,7 @@ ProceduralScene demo_scene(const DemoArgs& a) {
 
 // One CCD step of a procedural scene through every culling mode and cone policy.
 int run_detection_demo(const DemoArgs& a) {
-  if (a.bvh != "patch" && a.bvh != "spatial") {
-    throw InputError(fmt::format("demo: unknown --bvh '{}' (spatial|patch)", a.bvh));
-  }
+  const BvhBuild build = parse_bvh_build(a.bvh, "demo: --bvh");
   std::optional<tbb::global_control> threads;
   if (a.threads > 0) {
     threads.emplace(tbb::global_control::max_allowed_parallelism,
@@ -271,7 +270,7 @@ int run_detection_demo(const DemoArgs& a) {
   }
   const ProceduralScene s = demo_scene(a);
   DetectOptions o;
-  o.build = a.bvh == "patch" ? BvhBuild::Patch : BvhBuild::Spatial;
+  o.build = build;
   const auto t = std::chrono::steady_clock::now();
   SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
   const double build_s =

@@ -8,14 +8,15 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "atomic_json.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/detect/names.hpp"
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/sewing.hpp"
@@ -64,13 +65,6 @@ nlohmann::json stats_json(const DetectStats& s) {
           {"time_narrow", s.time_narrow}};
 }
 
-template <class T>
-T pick(const std::string& name, const std::string& value, const std::map<std::string, T>& m) {
-  const auto it = m.find(value);
-  if (it == m.end()) throw InputError(fmt::format("--{}: unknown value '{}'", name, value));
-  return it->second;
-}
-
 // The two frames of the step: --t1, or t0 plus a smooth perturbation; optionally cut to the
 // garment prefix of a drape.obj (its first N vertices and the faces that use only them).
 std::pair<TriangleMesh, TriangleMesh> load_frames(const Args& a) {
@@ -107,9 +101,7 @@ std::pair<TriangleMesh, TriangleMesh> load_frames(const Args& a) {
 
 // One row of --table: a configuration and its result.
 struct Row {
-  const char* bvh;
-  const char* culling;
-  const char* policy;
+  std::string_view bvh, culling, policy;
   DetectResult r;
 };
 
@@ -120,34 +112,30 @@ using cli::missed_against;
 void print_table(const TriangleMesh& w0, const TriangleMesh& w1, double thickness,
                  bool with_optimal) {
   const Positions p0 = vertices_matrix(w0), p1 = vertices_matrix(w1);
-  const std::pair<const char*, BvhBuild> builds[] = {{"spatial", BvhBuild::Spatial},
-                                                     {"patch", BvhBuild::Patch}};
-  const std::pair<const char*, Culling> modes[] = {
-      {"cone", Culling::Cone}, {"gated", Culling::Gated}, {"sound", Culling::Sound}};
-  const std::pair<const char*, ConePolicy> policies[] = {{"PROVOT", ConePolicy::Provot},
-                                                         {"PROPOSED", ConePolicy::Proposed},
-                                                         {"EXACT", ConePolicy::Exact},
-                                                         {"OPTIMAL", ConePolicy::Optimal}};
+  const BvhBuild builds[] = {BvhBuild::Spatial, BvhBuild::Patch};
+  const Culling modes[] = {Culling::Cone, Culling::Gated, Culling::Sound};
+  const ConePolicy policies[] = {ConePolicy::Provot, ConePolicy::Proposed, ConePolicy::Exact,
+                                 ConePolicy::Optimal};
   fmt::print(
       "\n| bvh | culling | policy | connected / disk internal nodes | triangle pairs | pairs "
       "culled "
       "vs none | nodes culled | contour fails | VF / EE tests | collisions | missed vs none | "
       "refit / traverse / narrow (s) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-  for (const auto& [bname, build] : builds) {
+  for (const BvhBuild build : builds) {
     DetectOptions o;
     o.build = build;
     o.thickness = thickness;
     SelfDetector det(w0.faces, w0.num_vertices(), p0, o);
     const DetectResult none = det.detect(p0, p1);
     std::vector<Row> rows;
-    rows.push_back({bname, "none", "-", none});
-    for (const auto& [mname, mode] : modes) {
-      for (const auto& [pname, policy] : policies) {
+    rows.push_back({to_string(build), to_string(Culling::None), "-", none});
+    for (const Culling mode : modes) {
+      for (const ConePolicy policy : policies) {
         if (policy == ConePolicy::Optimal && !with_optimal) continue;
         o.culling = mode;
         o.policy = policy;
         det.set_options(o);
-        rows.push_back({bname, mname, pname, det.detect(p0, p1)});
+        rows.push_back({to_string(build), to_string(mode), to_string(policy), det.detect(p0, p1)});
       }
     }
     for (const Row& row : rows) {
@@ -168,18 +156,9 @@ void print_table(const TriangleMesh& w0, const TriangleMesh& w1, double thicknes
 
 int run(const Args& a) {
   DetectOptions o;
-  o.policy = pick<ConePolicy>("policy", a.policy,
-                              {{"provot", ConePolicy::Provot},
-                               {"proposed", ConePolicy::Proposed},
-                               {"exact", ConePolicy::Exact},
-                               {"optimal", ConePolicy::Optimal}});
-  o.culling = pick<Culling>("culling", a.culling,
-                            {{"none", Culling::None},
-                             {"cone", Culling::Cone},
-                             {"gated", Culling::Gated},
-                             {"sound", Culling::Sound}});
-  o.build =
-      pick<BvhBuild>("bvh", a.bvh, {{"spatial", BvhBuild::Spatial}, {"patch", BvhBuild::Patch}});
+  o.policy = parse_cone_policy(a.policy, "--policy");
+  o.culling = parse_culling(a.culling, "--culling");
+  o.build = parse_bvh_build(a.bvh, "--bvh");
   if (!(a.thickness >= 0)) throw InputError("--thickness must be >= 0");
   if (a.weld > 0 && a.sew > 0) throw InputError("give at most one of --weld and --sew");
   if (a.table && !a.json.empty()) throw InputError("--table writes no JSON; drop --json");

@@ -82,6 +82,11 @@ Positions positions(const py::handle& obj, const char* name) {
   return Eigen::Map<const RowMajor>(a.data(), a.shape(0), a.shape(1));
 }
 
+Positions PointsArg::matrix() const {
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  return Eigen::Map<const RowMajor>(array_.data(), array_.shape(0), array_.shape(1));
+}
+
 std::vector<Face> faces(const py::handle& obj, const char* name) {
   const auto a = int_array(obj, name, 2, "(m, 3)");
   if (a.size() == 0) return {};

@@ -9,6 +9,7 @@
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,33 @@ struct ArrayLike {
 /// positions as an owning Eigen::MatrixXd, so this one copy (O(n), no allocation per vertex) is
 /// the only one; a C-contiguous float64 array is read in place.
 [[nodiscard]] Positions positions(const py::handle& obj, const char* name);
+
+/// An (n, k) float array for the detectors' per-step calls. With k == 3 its rows are the points:
+/// a C-contiguous float64 array (NumPy's default) is read in place, with no copy; other dtypes and
+/// layouts are converted once. Another k is kept for matrix(), so that the library's own message
+/// names the wrong shape.
+class PointsArg {
+ public:
+  PointsArg(const py::handle& obj, const char* name) : array_(float_array(obj, name, 2)) {}
+  [[nodiscard]] bool has_points() const { return array_.shape(1) == 3; }
+  /// The rows as points (valid while this object lives); only when has_points().
+  [[nodiscard]] std::span<const Eigen::Vector3d> points() const {
+    return {reinterpret_cast<const Eigen::Vector3d*>(array_.data()),
+            static_cast<std::size_t>(array_.shape(0))};
+  }
+  [[nodiscard]] Positions matrix() const;
+
+ private:
+  py::array_t<double, py::array::c_style> array_;
+};
+
+/// Calls f with every argument's points when all of them have three columns, else with their
+/// matrices (the library then reports the wrong shape).
+template <class F, class... Args>
+auto with_points(F&& f, const Args&... args) {
+  if ((args.has_points() && ...)) return f(args.points()...);
+  return f(args.matrix()...);
+}
 
 /// An (m, 3) integer array as faces (ids checked to fit an int; their range is the library's).
 [[nodiscard]] std::vector<Face> faces(const py::handle& obj, const char* name);

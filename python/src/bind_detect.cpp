@@ -1,73 +1,16 @@
 // SelfDetector, PairDetector, their results and the procedural test scenes.
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cctype>
-#include <map>
 #include <optional>
 
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/detect/names.hpp"
 #include "clothcd/detect/procedural.hpp"
 
 namespace clothcd::python {
 namespace {
-
-template <class T>
-T pick(const char* what, std::string value, const std::map<std::string, T>& choices) {
-  std::transform(value.begin(), value.end(), value.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (const auto it = choices.find(value); it != choices.end()) return it->second;
-  std::string names;
-  for (const auto& [name, v] : choices)
-    names += (names.empty() ? "" : ", ") + name;
-  fail(fmt::format("{}: unknown value '{}' (one of {})", what, value, names));
-}
-
-ConePolicy policy_of(const std::string& s) {
-  return pick<ConePolicy>("policy", s,
-                          {{"provot", ConePolicy::Provot},
-                           {"proposed", ConePolicy::Proposed},
-                           {"exact", ConePolicy::Exact},
-                           {"optimal", ConePolicy::Optimal}});
-}
-Culling culling_of(const std::string& s) {
-  return pick<Culling>("culling", s,
-                       {{"none", Culling::None},
-                        {"cone", Culling::Cone},
-                        {"gated", Culling::Gated},
-                        {"sound", Culling::Sound}});
-}
-BvhBuild build_of(const std::string& s) {
-  return pick<BvhBuild>("bvh", s, {{"spatial", BvhBuild::Spatial}, {"patch", BvhBuild::Patch}});
-}
-const char* name_of(ConePolicy p) {
-  switch (p) {
-    case ConePolicy::Provot:
-      return "provot";
-    case ConePolicy::Proposed:
-      return "proposed";
-    case ConePolicy::Exact:
-      return "exact";
-    case ConePolicy::Optimal:
-      return "optimal";
-  }
-  return "?";
-}
-const char* name_of(Culling c) {
-  switch (c) {
-    case Culling::None:
-      return "none";
-    case Culling::Cone:
-      return "cone";
-    case Culling::Gated:
-      return "gated";
-    case Culling::Sound:
-      return "sound";
-  }
-  return "?";
-}
 
 // The options shared by both detectors' constructors; all keyword-only in Python.
 struct OptionArgs {
@@ -77,8 +20,8 @@ struct OptionArgs {
   std::optional<int> distance_filter_depth;
 
   void apply(DetectOptions& o) const {
-    if (policy) o.policy = policy_of(*policy);
-    if (culling) o.culling = culling_of(*culling);
+    if (policy) o.policy = parse_cone_policy(*policy, "policy");
+    if (culling) o.culling = parse_culling(*culling, "culling");
     if (thickness) {
       if (!(*thickness >= 0) || !std::isfinite(*thickness)) {
         fail(fmt::format("thickness must be finite and >= 0, got {}", *thickness));
@@ -95,8 +38,8 @@ struct OptionArgs {
 
 py::dict options_dict(const DetectOptions& o, const char* bvh) {
   py::dict d;
-  d["policy"] = name_of(o.policy);
-  d["culling"] = name_of(o.culling);
+  d["policy"] = std::string(to_string(o.policy));
+  d["culling"] = std::string(to_string(o.culling));
   d["bvh"] = bvh;
   d["thickness"] = o.thickness;
   d["np_filter"] = o.np_filter;
@@ -231,7 +174,7 @@ class PySelfDetector {
     std::vector<Face> f = faces(F, "F");
     const Positions v = positions(V, "V_rest");
     DetectOptions o;
-    o.build = build_of(bvh);
+    o.build = parse_bvh_build(bvh, "bvh");
     o.culling = Culling::Sound;
     args.apply(o);
     if (!linked.obj.is_none()) o.linked_vertices = index_pairs(linked, "linked_vertices");
@@ -249,14 +192,18 @@ class PySelfDetector {
   }
 
   SelfResult detect(const ArrayLike& V0, const ArrayLike& V1) {
-    const Positions a = positions(V0, "V0"), b = positions(V1, "V1");
-    DetectResult r = workers_.run([&] { return det_->detect(a, b); });
+    const PointsArg a(V0, "V0"), b(V1, "V1");
+    DetectResult r = workers_.run([&] {
+      return with_points([&](const auto& x0, const auto& x1) { return det_->detect(x0, x1); }, a,
+                         b);
+    });
     return SelfResult(r);
   }
 
   ProximityOut proximity(const ArrayLike& V, double h) {
-    const Positions a = positions(V, "V");
-    ProximityResult r = workers_.run([&] { return det_->proximity(a, h); });
+    const PointsArg a(V, "V");
+    ProximityResult r = workers_.run(
+        [&] { return with_points([&](const auto& x) { return det_->proximity(x, h); }, a); });
     return ProximityOut(r);
   }
 
@@ -272,8 +219,8 @@ class PySelfDetector {
     workers_.run([&] { det_->clear_active_faces(); });
   }
   void rebuild(const ArrayLike& V) {
-    const Positions a = positions(V, "V");
-    workers_.run([&] { det_->rebuild(a); });
+    const PointsArg a(V, "V");
+    workers_.run([&] { with_points([&](const auto& x) { det_->rebuild(x); }, a); });
   }
   void set_options(const OptionArgs& args, std::optional<bool> verify) {
     DetectOptions o = det_->options();
@@ -309,7 +256,7 @@ class PyPairDetector {
     std::vector<Face> fa = faces(Fa, "F_a"), fb = faces(Fb, "F_b");
     const Positions a = positions(Va, "V_a"), b = positions(Vb, "V_b");
     DetectOptions o;
-    o.build = build_of(bvh);
+    o.build = parse_bvh_build(bvh, "bvh");
     args.apply(o);
     // The detector numbers edges as a Topology of the same faces does.
     const Topology ta(fa, static_cast<int>(a.rows())), tb(fb, static_cast<int>(b.rows()));
@@ -323,9 +270,10 @@ class PyPairDetector {
 
   PairResult detect(const ArrayLike& A0, const ArrayLike& A1, const ArrayLike& B0,
                     const ArrayLike& B1) {
-    const Positions a0 = positions(A0, "Va0"), a1 = positions(A1, "Va1");
-    const Positions b0 = positions(B0, "Vb0"), b1 = positions(B1, "Vb1");
-    PairDetectResult r = workers_.run([&] { return det_->detect(a0, a1, b0, b1); });
+    const PointsArg a0(A0, "Va0"), a1(A1, "Va1"), b0(B0, "Vb0"), b1(B1, "Vb1");
+    PairDetectResult r = workers_.run([&] {
+      return with_points([&](const auto&... x) { return det_->detect(x...); }, a0, a1, b0, b1);
+    });
     return PairResult(r);
   }
 

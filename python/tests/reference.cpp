@@ -16,6 +16,7 @@
 #include <string>
 
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/detect/names.hpp"
 #include "clothcd/detect/oracle.hpp"
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
@@ -35,17 +36,9 @@ int get_int(const Args& a, const std::string& key, int fallback) {
 
 DetectOptions options(const Args& a) {
   DetectOptions o;
-  const std::map<std::string, ConePolicy> policies{{"provot", ConePolicy::Provot},
-                                                   {"proposed", ConePolicy::Proposed},
-                                                   {"exact", ConePolicy::Exact},
-                                                   {"optimal", ConePolicy::Optimal}};
-  const std::map<std::string, Culling> cullings{{"none", Culling::None},
-                                                {"cone", Culling::Cone},
-                                                {"gated", Culling::Gated},
-                                                {"sound", Culling::Sound}};
-  o.policy = policies.at(get(a, "policy", "proposed"));
-  o.culling = cullings.at(get(a, "culling", "sound"));
-  o.build = get(a, "bvh", "patch") == "spatial" ? BvhBuild::Spatial : BvhBuild::Patch;
+  o.policy = parse_cone_policy(get(a, "policy", "proposed"), "policy");
+  o.culling = parse_culling(get(a, "culling", "sound"), "culling");
+  o.build = parse_bvh_build(get(a, "bvh", "patch"), "bvh");
   o.thickness = std::stod(get(a, "thickness", "0"));
   return o;
 }

@@ -221,6 +221,39 @@ def test_float32_and_lists_are_accepted():
     assert np.array_equal(r1.vf, r2.vf) and np.array_equal(r1.ee_toi, r2.ee_toi)
 
 
+def test_every_array_layout_gives_the_same_results():
+    # C-contiguous float64 is read in place; the other layouts are converted: all agree exactly.
+    F, V0, V1 = clothcd.procedural.crumpled_sheet(10, 2)
+
+    def layouts(V):
+        wide = np.repeat(V, 2, axis=1)  # columns x x y y z z: [:, ::2] is a strided view of V
+        frozen = V.copy()
+        frozen.flags.writeable = False
+        return [V, np.asfortranarray(V), wide[:, ::2], frozen]
+
+    det = clothcd.SelfDetector(F, V0, culling="sound", thickness=1e-3)
+    want = det.detect(V0, V1)
+    near = det.proximity(V1, 0.05)
+    assert len(want.vf) + len(want.ee) > 0 and len(near.vf) + len(near.ee) > 0
+    for a, b in zip(layouts(V0), layouts(V1)):
+        got = det.detect(a, b)
+        assert np.array_equal(got.vf, want.vf) and np.array_equal(got.vf_toi, want.vf_toi)
+        assert np.array_equal(got.ee, want.ee) and np.array_equal(got.ee_toi, want.ee_toi)
+        p = det.proximity(b, 0.05)
+        assert np.array_equal(p.vf, near.vf) and np.array_equal(p.vf_distance, near.vf_distance)
+        assert np.array_equal(p.ee, near.ee) and np.array_equal(p.ee_distance, near.ee_distance)
+        det.rebuild(b)
+    n = len(V0) // 2
+    m = np.nonzero(F.max(axis=1) < n)[0]
+    pd = clothcd.PairDetector(F[m], V0[:n], F[m], V0[:n] + [0, 0, 0.02])
+    pref = pd.detect(V0[:n], V1[:n], V0[:n] + [0, 0, 0.02], V1[:n] - [0, 0, 0.02])
+    assert len(pref.vf_a_on_b) + len(pref.ee) > 0
+    for a0, a1 in zip(layouts(V0[:n]), layouts(V1[:n])):
+        got = pd.detect(a0, a1, V0[:n] + [0, 0, 0.02], V1[:n] - [0, 0, 0.02])
+        assert np.array_equal(got.vf_a_on_b, pref.vf_a_on_b) and np.array_equal(got.ee, pref.ee)
+        assert np.array_equal(got.ee_toi, pref.ee_toi)
+
+
 def test_detect_releases_the_gil():
     import threading
     import time

@@ -81,7 +81,7 @@ struct SelfDetector::Impl {
     std::vector<std::pair<int, int>> pairs;
   } reuse;
 
-  Impl(std::vector<Face> faces, int nv, const Positions& ref, const DetectOptions& o)
+  Impl(std::vector<Face> faces, int nv, detail::PointsIn ref, const DetectOptions& o)
       : topo(std::move(faces), nv), opt(o) {
     check_options(o);
     detail::to_points(ref, nv, "reference shape", v0);
@@ -341,7 +341,7 @@ struct SelfDetector::Impl {
     }
   }
 
-  DetectResult detect(const Positions& p0, const Positions& p1) {
+  DetectResult detect(detail::PointsIn p0, detail::PointsIn p1) {
     detail::to_points(p0, topo.num_vertices(), "positions at t0", v0);
     detail::to_points(p1, topo.num_vertices(), "positions at t1", v1);
     if (!links_current) {
@@ -395,7 +395,7 @@ struct SelfDetector::Impl {
     return res;
   }
 
-  ProximityResult proximity(const Positions& p, double h) {
+  ProximityResult proximity(detail::PointsIn p, double h) {
     if (!(h >= 0) || !std::isfinite(h)) {
       throw InputError(fmt::format("proximity distance must be finite and >= 0, got {}", h));
     }
@@ -542,9 +542,27 @@ struct SelfDetector::Impl {
   }
 };
 
+namespace {
+// SelfDetector::rebuild for either input form.
+template <class Impl>
+void rebuild_detector(Impl& im, detail::PointsIn reference) {
+  std::vector<Eigen::Vector3d> ref;
+  detail::to_points(reference, im.topo.num_vertices(), "reference shape", ref);
+  im.bvh = Bvh(im.topo, ref, im.opt.build);
+  im.restricted = false;  // its node flags belonged to the old tree
+}
+}  // namespace
+
 SelfDetector::SelfDetector(std::vector<Face> faces, int num_vertices, const Positions& reference,
                            const DetectOptions& options)
     : impl_(std::make_unique<Impl>(std::move(faces), num_vertices, reference, options)) {}
+SelfDetector::SelfDetector(std::vector<Face> faces, int num_vertices,
+                           std::span<const Eigen::Vector3d> reference, const DetectOptions& options)
+    : impl_(std::make_unique<Impl>(std::move(faces), num_vertices, reference, options)) {}
+SelfDetector::SelfDetector(const Eigen::Ref<const Eigen::MatrixX3i>& faces,
+                           const Positions& reference, const DetectOptions& options)
+    : impl_(std::make_unique<Impl>(to_faces(faces), static_cast<int>(reference.rows()), reference,
+                                   options)) {}
 SelfDetector::~SelfDetector() = default;
 SelfDetector::SelfDetector(SelfDetector&&) noexcept = default;
 SelfDetector& SelfDetector::operator=(SelfDetector&&) noexcept = default;
@@ -552,7 +570,14 @@ SelfDetector& SelfDetector::operator=(SelfDetector&&) noexcept = default;
 DetectResult SelfDetector::detect(const Positions& v_t0, const Positions& v_t1) {
   return impl_->detect(v_t0, v_t1);
 }
+DetectResult SelfDetector::detect(std::span<const Eigen::Vector3d> v_t0,
+                                  std::span<const Eigen::Vector3d> v_t1) {
+  return impl_->detect(v_t0, v_t1);
+}
 ProximityResult SelfDetector::proximity(const Positions& v, double h) {
+  return impl_->proximity(v, h);
+}
+ProximityResult SelfDetector::proximity(std::span<const Eigen::Vector3d> v, double h) {
   return impl_->proximity(v, h);
 }
 void SelfDetector::set_active_faces(std::span<const int> faces) {
@@ -565,11 +590,10 @@ void SelfDetector::clear_active_faces() {
   impl_->restricted = false;
 }
 void SelfDetector::rebuild(const Positions& reference) {
-  Impl& im = *impl_;
-  std::vector<Eigen::Vector3d> ref;
-  detail::to_points(reference, im.topo.num_vertices(), "reference shape", ref);
-  im.bvh = Bvh(im.topo, ref, im.opt.build);
-  im.restricted = false;  // its node flags belonged to the old tree
+  rebuild_detector(*impl_, reference);
+}
+void SelfDetector::rebuild(std::span<const Eigen::Vector3d> reference) {
+  rebuild_detector(*impl_, reference);
 }
 const DetectOptions& SelfDetector::options() const {
   return impl_->opt;

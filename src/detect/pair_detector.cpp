@@ -59,7 +59,7 @@ struct Side {
   // Active vertices, the edges and faces touching one, and the nodes holding such a face.
   std::vector<std::uint8_t> vertex_active, edge_active, face_active, node_active;
 
-  Side(std::vector<Face> faces, int nv, const Positions& ref, std::string_view name, BvhBuild build)
+  Side(std::vector<Face> faces, int nv, detail::PointsIn ref, std::string_view name, BvhBuild build)
       : topo(std::move(faces), nv) {
     detail::to_points(ref, nv, name, x0);
     bvh = Bvh::boxes_only(topo, x0, build);  // no cones: they cannot cull between two meshes
@@ -172,8 +172,8 @@ struct PairDetector::Impl {
   Side a, b;
   bool restricted = false;
 
-  Impl(std::vector<Face> fa, int na, const Positions& ra, std::vector<Face> fb, int nb,
-       const Positions& rb, const DetectOptions& o)
+  Impl(std::vector<Face> fa, int na, detail::PointsIn ra, std::vector<Face> fb, int nb,
+       detail::PointsIn rb, const DetectOptions& o)
       : opt((check_pair_options(o), o)),
         a(std::move(fa), na, ra, "reference shape A", o.build),
         b(std::move(fb), nb, rb, "reference shape B", o.build) {}
@@ -220,8 +220,8 @@ struct PairDetector::Impl {
     return pairs;
   }
 
-  PairDetectResult detect(const Positions& a_t0, const Positions& a_t1, const Positions& b_t0,
-                          const Positions& b_t1) {
+  PairDetectResult detect(detail::PointsIn a_t0, detail::PointsIn a_t1, detail::PointsIn b_t0,
+                          detail::PointsIn b_t1) {
     detail::to_points(a_t0, a.topo.num_vertices(), "mesh A at t0", a.x0);
     detail::to_points(a_t1, a.topo.num_vertices(), "mesh A at t1", a.x1);
     detail::to_points(b_t0, b.topo.num_vertices(), "mesh B at t0", b.x0);
@@ -289,7 +289,7 @@ struct PairDetector::Impl {
     return res;
   }
 
-  PairProximityResult proximity(const Positions& pa, const Positions& pb, double h) {
+  PairProximityResult proximity(detail::PointsIn pa, detail::PointsIn pb, double h) {
     if (!(h >= 0) || !std::isfinite(h)) {
       throw InputError(fmt::format("proximity distance must be finite and >= 0, got {}", h));
     }
@@ -366,12 +366,38 @@ struct PairDetector::Impl {
   }
 };
 
+namespace {
+// PairDetector::rebuild for either input form.
+template <class Impl>
+void rebuild_detector(Impl& m, detail::PointsIn reference_a, detail::PointsIn reference_b) {
+  std::vector<Eigen::Vector3d> ra, rb;
+  detail::to_points(reference_a, m.a.topo.num_vertices(), "reference shape A", ra);
+  detail::to_points(reference_b, m.b.topo.num_vertices(), "reference shape B", rb);
+  m.a.bvh = Bvh::boxes_only(m.a.topo, ra, m.opt.build);
+  m.b.bvh = Bvh::boxes_only(m.b.topo, rb, m.opt.build);
+  m.restricted = false;  // its node flags belonged to the old trees
+}
+}  // namespace
+
 PairDetector::PairDetector(std::vector<Face> faces_a, int num_vertices_a,
                            const Positions& reference_a, std::vector<Face> faces_b,
                            int num_vertices_b, const Positions& reference_b,
                            const DetectOptions& options)
     : impl_(std::make_unique<Impl>(std::move(faces_a), num_vertices_a, reference_a,
                                    std::move(faces_b), num_vertices_b, reference_b, options)) {}
+PairDetector::PairDetector(std::vector<Face> faces_a, int num_vertices_a,
+                           std::span<const Eigen::Vector3d> reference_a, std::vector<Face> faces_b,
+                           int num_vertices_b, std::span<const Eigen::Vector3d> reference_b,
+                           const DetectOptions& options)
+    : impl_(std::make_unique<Impl>(std::move(faces_a), num_vertices_a, reference_a,
+                                   std::move(faces_b), num_vertices_b, reference_b, options)) {}
+PairDetector::PairDetector(const Eigen::Ref<const Eigen::MatrixX3i>& faces_a,
+                           const Positions& reference_a,
+                           const Eigen::Ref<const Eigen::MatrixX3i>& faces_b,
+                           const Positions& reference_b, const DetectOptions& options)
+    : impl_(std::make_unique<Impl>(to_faces(faces_a), static_cast<int>(reference_a.rows()),
+                                   reference_a, to_faces(faces_b),
+                                   static_cast<int>(reference_b.rows()), reference_b, options)) {}
 PairDetector::~PairDetector() = default;
 PairDetector::PairDetector(PairDetector&&) noexcept = default;
 PairDetector& PairDetector::operator=(PairDetector&&) noexcept = default;
@@ -380,7 +406,17 @@ PairDetectResult PairDetector::detect(const Positions& a_t0, const Positions& a_
                                       const Positions& b_t0, const Positions& b_t1) {
   return impl_->detect(a_t0, a_t1, b_t0, b_t1);
 }
+PairDetectResult PairDetector::detect(std::span<const Eigen::Vector3d> a_t0,
+                                      std::span<const Eigen::Vector3d> a_t1,
+                                      std::span<const Eigen::Vector3d> b_t0,
+                                      std::span<const Eigen::Vector3d> b_t1) {
+  return impl_->detect(a_t0, a_t1, b_t0, b_t1);
+}
 PairProximityResult PairDetector::proximity(const Positions& a, const Positions& b, double h) {
+  return impl_->proximity(a, b, h);
+}
+PairProximityResult PairDetector::proximity(std::span<const Eigen::Vector3d> a,
+                                            std::span<const Eigen::Vector3d> b, double h) {
   return impl_->proximity(a, b, h);
 }
 void PairDetector::set_active_vertices(std::span<const int> vertices_a,
@@ -394,13 +430,11 @@ void PairDetector::clear_active() {
   impl_->restricted = false;
 }
 void PairDetector::rebuild(const Positions& reference_a, const Positions& reference_b) {
-  Impl& m = *impl_;
-  std::vector<Eigen::Vector3d> ra, rb;
-  detail::to_points(reference_a, m.a.topo.num_vertices(), "reference shape A", ra);
-  detail::to_points(reference_b, m.b.topo.num_vertices(), "reference shape B", rb);
-  m.a.bvh = Bvh::boxes_only(m.a.topo, ra, m.opt.build);
-  m.b.bvh = Bvh::boxes_only(m.b.topo, rb, m.opt.build);
-  m.restricted = false;  // its node flags belonged to the old trees
+  rebuild_detector(*impl_, reference_a, reference_b);
+}
+void PairDetector::rebuild(std::span<const Eigen::Vector3d> reference_a,
+                           std::span<const Eigen::Vector3d> reference_b) {
+  rebuild_detector(*impl_, reference_a, reference_b);
 }
 const DetectOptions& PairDetector::options() const {
   return impl_->opt;

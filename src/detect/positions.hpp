@@ -1,10 +1,11 @@
 #pragma once
-// Validation of position matrices at the public boundary.
+// Validation of positions at the public boundary, for either input form the detectors accept.
 
 #include <fmt/format.h>
 #include <Eigen/Core>
 
 #include <cmath>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -12,16 +13,41 @@
 
 namespace clothcd::detail {
 
-/// Rows of an n x 3 matrix as points; throws InputError naming the matrix and the bad vertex.
-inline void to_points(const Eigen::MatrixXd& m, int num_vertices, std::string_view name,
+/// Positions as a caller passed them: a column-major n x 3 matrix or a span of points (no copy of
+/// either is made here).
+class PointsIn {
+ public:
+  PointsIn(const Eigen::MatrixXd& m) : matrix_(&m) {}                     // NOLINT: implicit
+  PointsIn(std::span<const Eigen::Vector3d> points) : points_(points) {}  // NOLINT: implicit
+
+  [[nodiscard]] const Eigen::MatrixXd* matrix() const { return matrix_; }
+  [[nodiscard]] std::span<const Eigen::Vector3d> points() const { return points_; }
+
+ private:
+  const Eigen::MatrixXd* matrix_ = nullptr;
+  std::span<const Eigen::Vector3d> points_;
+};
+
+/// Copies the positions into `out`; throws InputError naming the input and the bad vertex.
+inline void to_points(PointsIn in, int num_vertices, std::string_view name,
                       std::vector<Eigen::Vector3d>& out) {
-  if (m.rows() != num_vertices || m.cols() != 3) {
-    throw InputError(fmt::format("{}: expected a {} x 3 position matrix, got {} x {}", name,
-                                 num_vertices, m.rows(), m.cols()));
+  if (const Eigen::MatrixXd* m = in.matrix()) {
+    if (m->rows() != num_vertices || m->cols() != 3) {
+      throw InputError(fmt::format("{}: expected a {} x 3 position matrix, got {} x {}", name,
+                                   num_vertices, m->rows(), m->cols()));
+    }
+    out.resize(num_vertices);
+    for (int i = 0; i < num_vertices; ++i)
+      out[i] = m->row(i).transpose();
+  } else {
+    const auto points = in.points();
+    if (points.size() != static_cast<std::size_t>(num_vertices)) {
+      throw InputError(fmt::format("{}: expected a {} x 3 position matrix, got {} x 3", name,
+                                   num_vertices, points.size()));
+    }
+    out.assign(points.begin(), points.end());
   }
-  out.resize(num_vertices);
   for (int i = 0; i < num_vertices; ++i) {
-    out[i] = m.row(i).transpose();
     if (!out[i].allFinite()) {
       throw InputError(fmt::format("{}: vertex {} has a non-finite coordinate", name, i));
     }

@@ -11,15 +11,10 @@
 #include <sstream>
 
 #include "clothcd/core/error.hpp"
+#include "clothcd/detect/names.hpp"
 
 namespace clothcd::experiment {
 namespace {
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 struct StepCol {
   const char* name;
@@ -114,62 +109,27 @@ std::string num(double v) {
 
 }  // namespace
 
+// The paper's tables spell the policies in capitals (PROVOT, PROPOSED, ...).
 std::string policy_name(ConePolicy p) {
-  switch (p) {
-    case ConePolicy::Provot:
-      return "PROVOT";
-    case ConePolicy::Proposed:
-      return "PROPOSED";
-    case ConePolicy::Exact:
-      return "EXACT";
-    case ConePolicy::Optimal:
-      return "OPTIMAL";
-  }
-  return "?";
+  std::string s(to_string(p));
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  return s;
 }
-
 std::string culling_name(Culling c) {
-  switch (c) {
-    case Culling::None:
-      return "none";
-    case Culling::Cone:
-      return "cone";
-    case Culling::Gated:
-      return "gated";
-    case Culling::Sound:
-      return "sound";
-  }
-  return "?";
+  return std::string(to_string(c));
 }
-
 std::string build_name(BvhBuild b) {
-  return b == BvhBuild::Spatial ? "spatial" : "patch";
+  return std::string(to_string(b));
 }
-
 ConePolicy parse_policy(const std::string& s, const std::string& option) {
-  const std::string l = lower(s);
-  if (l == "provot") return ConePolicy::Provot;
-  if (l == "proposed") return ConePolicy::Proposed;
-  if (l == "exact") return ConePolicy::Exact;
-  if (l == "optimal") return ConePolicy::Optimal;
-  throw InputError(
-      fmt::format("{}: unknown policy '{}' (provot|proposed|exact|optimal)", option, s));
+  return parse_cone_policy(s, option);
 }
-
 Culling parse_culling(const std::string& s, const std::string& option) {
-  const std::string l = lower(s);
-  if (l == "none") return Culling::None;
-  if (l == "cone") return Culling::Cone;
-  if (l == "gated") return Culling::Gated;
-  if (l == "sound") return Culling::Sound;
-  throw InputError(fmt::format("{}: unknown culling '{}' (none|cone|gated|sound)", option, s));
+  return clothcd::parse_culling(s, option);
 }
-
 BvhBuild parse_build(const std::string& s, const std::string& option) {
-  const std::string l = lower(s);
-  if (l == "spatial") return BvhBuild::Spatial;
-  if (l == "patch") return BvhBuild::Patch;
-  throw InputError(fmt::format("{}: unknown build '{}' (spatial|patch)", option, s));
+  return parse_bvh_build(s, option);
 }
 
 std::vector<StepRow> read_step_rows(const std::filesystem::path& csv) {

@@ -235,4 +235,11 @@ std::vector<std::uint8_t> Topology::edges_touching(
   return out;
 }
 
+std::vector<Face> to_faces(const Eigen::Ref<const Eigen::MatrixX3i>& faces) {
+  std::vector<Face> out(static_cast<std::size_t>(faces.rows()));
+  for (Eigen::Index f = 0; f < faces.rows(); ++f)
+    out[f] = {faces(f, 0), faces(f, 1), faces(f, 2)};
+  return out;
+}
+
 }  // namespace clothcd

@@ -1,4 +1,4 @@
-// Sewn garments (docs/detect.md, garment section): the patch BVH keeps at least 99% of its
+// Sewn garments: the patch BVH keeps at least 99% of its
 // internal nodes edge-connected; on a step from the drape to a smoothly perturbed pose the sound
 // culling finds exactly what the unculled traversal finds in every policy and build, and on the
 // dress it culls at least half as many triangle pairs as the paper's cone-only rule.

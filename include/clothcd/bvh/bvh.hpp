@@ -86,7 +86,10 @@ class Bvh {
   [[nodiscard]] int depth() const { return static_cast<int>(level_offsets_.size()) - 1; }
   /// The oriented boundary loop (vertex ids) of a disk node; empty for other nodes.
   [[nodiscard]] std::span<const int> contour(int node) const;
-  /// Normal cones of the last refit with cones, one per node.
+  /// Normal cones of the last refit with cones, one per node. A saturated cone (one that bounds
+  /// no half-space) has a half-angle of at least pi/2: pi/2 exactly where a cone function made it
+  /// (kSaturatedHalfAngle), pi for an internal node above a saturated child. Test it with
+  /// NormalCone::saturated(), not by comparing the angle.
   [[nodiscard]] const std::vector<NormalCone>& cones() const { return cones_; }
   [[nodiscard]] const Topology& topology() const { return *topology_; }
   /// Sum of the internal nodes' box surface areas over the leaves', at the last refit. A tree

@@ -15,7 +15,26 @@
 namespace clothcd {
 
 /// n x 3 vertex positions, one row per vertex.
+///
+/// Every call that takes positions has two forms:
+/// - `const Positions&` (Eigen's default column-major matrix): read row by row;
+/// - `std::span<const Eigen::Vector3d>` (e.g. a `std::vector<Eigen::Vector3d>`, or
+///   `as_points(m)` of a row-major n x 3 matrix or a C-contiguous (n, 3) float64 NumPy array):
+///   read straight from the caller's memory, with no intermediate matrix.
+/// Both give the same results. Either way the detector copies the positions once into its own
+/// arrays (it compares the next call's positions with them to redo only what moved), checks that
+/// there are n of them and that they are finite, and keeps no reference to the caller's memory.
 using Positions = Eigen::MatrixXd;
+
+/// n x 3 row-major positions: the memory layout of a `std::vector<Eigen::Vector3d>` and of
+/// NumPy's default (n, 3) float64 array.
+using RowPositions = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+/// The rows of a row-major n x 3 matrix as points, without a copy (valid while `m` lives).
+[[nodiscard]] inline std::span<const Eigen::Vector3d> as_points(const RowPositions& m) {
+  static_assert(sizeof(Eigen::Vector3d) == 3 * sizeof(double), "Vector3d must be 3 packed doubles");
+  return {reinterpret_cast<const Eigen::Vector3d*>(m.data()), static_cast<std::size_t>(m.rows())};
+}
 
 /// Proximity pairs: features closer than h at one instant (no cones: docs/algorithms.md 1.1).
 struct ProximityResult {
@@ -40,6 +59,11 @@ class SelfDetector {
   /// or the first frame). Throws InputError on bad faces or a reference of the wrong size.
   SelfDetector(std::vector<Face> faces, int num_vertices, const Positions& reference,
                const DetectOptions& options = {});
+  SelfDetector(std::vector<Face> faces, int num_vertices,
+               std::span<const Eigen::Vector3d> reference, const DetectOptions& options = {});
+  /// Faces as an m x 3 integer matrix (libigl's F), one vertex per row of `reference` (its V).
+  SelfDetector(const Eigen::Ref<const Eigen::MatrixX3i>& faces, const Positions& reference,
+               const DetectOptions& options = {});
   ~SelfDetector();
   SelfDetector(SelfDetector&&) noexcept;
   SelfDetector& operator=(SelfDetector&&) noexcept;
@@ -47,10 +71,13 @@ class SelfDetector {
   /// All VF and EE pairs that touch during the linear motion v_t0 -> v_t1 (CCD). Results are
   /// sorted and do not depend on the number of threads.
   [[nodiscard]] DetectResult detect(const Positions& v_t0, const Positions& v_t1);
+  [[nodiscard]] DetectResult detect(std::span<const Eigen::Vector3d> v_t0,
+                                    std::span<const Eigen::Vector3d> v_t1);
 
   /// VF and EE pairs closer than h at positions v (box culling only). After a detect() with
   /// DetectOptions::reuse_distance >= h, it starts from that call's pairs (the same results).
   [[nodiscard]] ProximityResult proximity(const Positions& v, double h);
+  [[nodiscard]] ProximityResult proximity(std::span<const Eigen::Vector3d> v, double h);
 
   /// Restricts detection to pairs in which at least one feature belongs to an active triangle.
   void set_active_faces(std::span<const int> faces);
@@ -65,6 +92,7 @@ class SelfDetector {
   /// slow down. Results do not change. Clears an active restriction; keeps the pairs kept for
   /// reuse (DetectOptions::reuse_distance). Throws InputError for a reference of the wrong size.
   void rebuild(const Positions& reference);
+  void rebuild(std::span<const Eigen::Vector3d> reference);
 
   [[nodiscard]] const DetectOptions& options() const;
   void set_options(const DetectOptions& options);  ///< the BVH build stays as constructed
@@ -104,6 +132,14 @@ class PairDetector {
   PairDetector(std::vector<Face> faces_a, int num_vertices_a, const Positions& reference_a,
                std::vector<Face> faces_b, int num_vertices_b, const Positions& reference_b,
                const DetectOptions& options = {});
+  PairDetector(std::vector<Face> faces_a, int num_vertices_a,
+               std::span<const Eigen::Vector3d> reference_a, std::vector<Face> faces_b,
+               int num_vertices_b, std::span<const Eigen::Vector3d> reference_b,
+               const DetectOptions& options = {});
+  /// Faces as m x 3 integer matrices, one vertex per row of each reference.
+  PairDetector(const Eigen::Ref<const Eigen::MatrixX3i>& faces_a, const Positions& reference_a,
+               const Eigen::Ref<const Eigen::MatrixX3i>& faces_b, const Positions& reference_b,
+               const DetectOptions& options = {});
   ~PairDetector();
   PairDetector(PairDetector&&) noexcept;
   PairDetector& operator=(PairDetector&&) noexcept;
@@ -113,10 +149,16 @@ class PairDetector {
   /// same results as from scratch): a simulator's later passes pay for what changed.
   [[nodiscard]] PairDetectResult detect(const Positions& a_t0, const Positions& a_t1,
                                         const Positions& b_t0, const Positions& b_t1);
+  [[nodiscard]] PairDetectResult detect(std::span<const Eigen::Vector3d> a_t0,
+                                        std::span<const Eigen::Vector3d> a_t1,
+                                        std::span<const Eigen::Vector3d> b_t0,
+                                        std::span<const Eigen::Vector3d> b_t1);
 
   /// VF and EE pairs between A and B closer than h at positions a and b, with their distances
   /// (box culling only); honours the active restriction like detect().
   [[nodiscard]] PairProximityResult proximity(const Positions& a, const Positions& b, double h);
+  [[nodiscard]] PairProximityResult proximity(std::span<const Eigen::Vector3d> a,
+                                              std::span<const Eigen::Vector3d> b, double h);
 
   /// Restricts detection to pairs with an active vertex (ids of A and of B): a VF pair when its
   /// vertex or a vertex of its face is active, an EE pair when an endpoint is active. Throws
@@ -128,6 +170,8 @@ class PairDetector {
   /// change, loose boxes of a tree refit far from its build shape cost time). Clears an active
   /// restriction. Throws InputError for a reference of the wrong size.
   void rebuild(const Positions& reference_a, const Positions& reference_b);
+  void rebuild(std::span<const Eigen::Vector3d> reference_a,
+               std::span<const Eigen::Vector3d> reference_b);
 
   [[nodiscard]] const DetectOptions& options() const;
   /// Throws InputError like the constructor; the BVH build stays as constructed.

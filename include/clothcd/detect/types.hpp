@@ -25,9 +25,16 @@ struct DetectOptions {
   ConePolicy policy = ConePolicy::Proposed;
   Culling culling = Culling::None;
   BvhBuild build = BvhBuild::Spatial;
-  /// Contact distance of the CCD kernels; boxes grow with it. Culling::Sound stays exact at any
-  /// thickness: it then culls only nodes whose features provably stay out of the kernels' reach
-  /// (docs/algorithms.md 1.6).
+  /// Contact distance h >= 0 (the thickness model, docs/detect.md "Thickness"):
+  /// - reported: every VF / EE pair whose features come within Euclidean distance h of each other
+  ///   at some time of the step (no false negatives);
+  /// - certified by a hit: only that they came within sqrt(3) (h + 1e-6 L), L the pair's extent
+  ///   (the kernels reject in the infinity norm, to the inclusion solver's tolerance), so a few
+  ///   pairs slightly farther than h may be reported too;
+  /// - boxes: every swept box grows by h / 2 on each side (rounded outwards), so two boxes overlap
+  ///   whenever their features come within h in every coordinate.
+  /// Culling::Sound stays exact at any thickness: it culls only nodes whose features provably stay
+  /// out of that reach (docs/algorithms.md 1.6).
   double thickness = 0.0;
   /// Deforming NP filter before the kernels (applied at zero thickness only).
   bool np_filter = true;

@@ -3,6 +3,8 @@
 /// Connectivity of a triangle mesh: unique edges, incidences, adjacency, components.
 /// Built once from the faces; positions live elsewhere (they change every step).
 
+#include <Eigen/Core>
+
 #include <array>
 #include <cstdint>
 #include <span>
@@ -12,6 +14,10 @@ namespace clothcd {
 
 using Face = std::array<int, 3>;
 using Edge = std::array<int, 2>;  ///< (smaller vertex id, larger vertex id)
+
+/// Rows of an m x 3 integer matrix (libigl's F) as faces; ids are checked where a Topology is
+/// made.
+[[nodiscard]] std::vector<Face> to_faces(const Eigen::Ref<const Eigen::MatrixX3i>& faces);
 
 /// Validated topology. Construction throws clothcd::InputError naming the face and what is wrong
 /// for an index out of range or a face that repeats a vertex. Duplicate faces and non-manifold
