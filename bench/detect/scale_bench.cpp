@@ -1,7 +1,7 @@
 // One CCD step and one proximity query of the self detector on a folding sheet of a given number
 // of triangles (crumpled_sheet, an n x n grid of 2 n^2 triangles), in a process of its own so
 // that the peak memory is this size's: scripts/detect_scale_bench.sh runs it for each size and
-// writes the table of docs/detect.md.
+// writes the table of docs/results/scale.md.
 //
 // The step is a simulator-sized part of the sheet's folding motion: from 80% of the way to 80%
 // plus 1/n, so a vertex moves about a third of a cell (the geometry is the same surface at every
