@@ -50,7 +50,8 @@ struct Totals {
   int frames = 0;
   long long substeps = 0;
   SelfCcdFigures ccd;
-  std::vector<double> frame_seconds;
+  SelfProximityFigures proximity;
+  std::vector<double> frame_seconds, collision_seconds;
 };
 
 struct SceneResult {
@@ -156,7 +157,9 @@ SceneResult run_scene(const fs::path& file, int frames) {
       ++t.frames;
       t.substeps += fs.substeps;
       t.ccd += fs.self_ccd;
+      t.proximity += fs.self_proximity;
       t.frame_seconds.push_back(fs.seconds);
+      t.collision_seconds.push_back(fs.collision_seconds);
       const SelfCcdFigures& c = fs.self_ccd;
       const SelfProximityFigures& p = fs.self_proximity;
       r.csv_rows.push_back(
@@ -194,10 +197,12 @@ std::string report(const InSituArgs& a, const std::vector<SceneResult>& results,
       "Self-CCD figures are summed over each frame's full passes (the first CCD pass of every "
       "substep and any other pass that tests every pair); restricted passes, proximity queries "
       "and body contact are left out. CD time = refit + traversal + narrow phase of those "
-      "calls. Frame time is the whole frame (dynamics, all contact handling), median over the "
-      "frames. 'none' tests every node; the others are the sound culling with the given "
-      "cones. Every frame's cloth positions and velocities were checked to be byte-identical "
-      "across the four settings.\n\n";
+      "calls. Proximity: the self proximity query at the start of every substep (it reuses the "
+      "full pass's kept pairs where it can; nodes the cones culled hold none). Contact time is "
+      "all contact handling of a frame (self and body, proximity, CCD passes, impact zones) and "
+      "frame time the whole frame, medians over the frames. 'none' tests every node; the "
+      "others are the sound culling with the given cones. Every frame's cloth positions and "
+      "velocities were checked to be byte-identical across the four settings.\n\n";
   md +=
       "Paper reference (Table 1-2, its own scenes and simulator): PROPOSED performs 0.75 of "
       "PROVOT's triangle pair tests and takes 0.82 of its CD time.\n";
@@ -206,8 +211,8 @@ std::string report(const InSituArgs& a, const std::vector<SceneResult>& results,
     md +=
         "| setting | frames | substeps | self-CCD calls | pair tests / call | pairs vs none | "
         "nodes culled / call | refit ms / call | traversal ms / call | narrow ms / call | "
-        "CD ms / call | frame s (median) |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "CD ms / call | proximity ms / call | contact s (median) | frame s (median) |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     const Totals& none = r.totals[0];
     for (std::size_t i = 0; i < kSettings.size(); ++i) {
       const Totals& t = r.totals[i];
@@ -215,21 +220,22 @@ std::string report(const InSituArgs& a, const std::vector<SceneResult>& results,
       const double cd = t.ccd.refit_s + t.ccd.traversal_s + t.ccd.narrow_s;
       md += fmt::format(
           "| {} | {} | {} | {} | {:.0f} | {} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | "
-          "{:.3f} |\n",
+          "{:.3f} | {:.3f} | {:.3f} |\n",
           kSettings[i].name, t.frames, t.substeps, c,
           per_call(static_cast<double>(t.ccd.triangle_pairs), c),
           ratio(static_cast<double>(t.ccd.triangle_pairs),
                 static_cast<double>(none.ccd.triangle_pairs)),
           per_call(static_cast<double>(t.ccd.nodes_culled), c), 1e3 * per_call(t.ccd.refit_s, c),
           1e3 * per_call(t.ccd.traversal_s, c), 1e3 * per_call(t.ccd.narrow_s, c),
-          1e3 * per_call(cd, c), median(t.frame_seconds));
+          1e3 * per_call(cd, c), 1e3 * per_call(t.proximity.query_s, t.proximity.calls),
+          median(t.collision_seconds), median(t.frame_seconds));
     }
     md +=
         "\nRatios to PROVOT (per call; paper: PROPOSED 0.75 of the pair tests, 0.82 of the CD "
         "time):\n\n"
         "| setting | pair tests | nodes culled | refit | traversal | narrow | CD time | "
-        "frame (median) | paper pair tests | paper CD time |\n"
-        "|---|---|---|---|---|---|---|---|---|---|\n";
+        "proximity | contact (median) | frame (median) | paper pair tests | paper CD time |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     const Totals& p = r.totals[kProvot];
     const long long pc = p.ccd.calls;
     for (std::size_t i = 0; i < kSettings.size(); ++i) {
@@ -242,13 +248,16 @@ std::string report(const InSituArgs& a, const std::vector<SceneResult>& results,
           kSettings[i].policy == ConePolicy::Proposed && kSettings[i].culling == Culling::Sound;
       const bool provot = i == kProvot;
       md += fmt::format(
-          "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", kSettings[i].name,
+          "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", kSettings[i].name,
           rel(static_cast<double>(t.ccd.triangle_pairs), static_cast<double>(p.ccd.triangle_pairs)),
           rel(static_cast<double>(t.ccd.nodes_culled), static_cast<double>(p.ccd.nodes_culled)),
           rel(t.ccd.refit_s, p.ccd.refit_s), rel(t.ccd.traversal_s, p.ccd.traversal_s),
           rel(t.ccd.narrow_s, p.ccd.narrow_s),
           rel(t.ccd.refit_s + t.ccd.traversal_s + t.ccd.narrow_s,
               p.ccd.refit_s + p.ccd.traversal_s + p.ccd.narrow_s),
+          ratio(per_call(t.proximity.query_s, t.proximity.calls),
+                per_call(p.proximity.query_s, p.proximity.calls)),
+          ratio(median(t.collision_seconds), median(p.collision_seconds)),
           ratio(median(t.frame_seconds), median(p.frame_seconds)),
           proposed ? "0.75"
           : provot ? "1"
@@ -267,8 +276,25 @@ std::string report(const InSituArgs& a, const std::vector<SceneResult>& results,
 int run_in_situ(const InSituArgs& a) {
   if (a.scenes.empty()) throw InputError("--in-situ: no scene files given");
   if (a.frames < 1) throw InputError("--frames: at least 1 frame");
+  // SCENE@N: at most N frames of that scene.
+  std::vector<std::pair<std::string, int>> scenes;
   for (const auto& s : a.scenes) {
-    if (!fs::is_regular_file(s)) throw InputError(fmt::format("--in-situ: no scene file '{}'", s));
+    std::string file = s;
+    int frames = a.frames;
+    if (const auto at = s.rfind('@'); at != std::string::npos && !fs::exists(s)) {
+      file = s.substr(0, at);
+      try {
+        std::size_t used = 0;
+        frames = std::min(frames, std::stoi(s.substr(at + 1), &used));
+        if (used != s.size() - at - 1 || frames < 1) throw std::invalid_argument(s);
+      } catch (const std::logic_error&) {
+        throw InputError(fmt::format("--in-situ: '{}': expected SCENE@FRAMES, FRAMES >= 1", s));
+      }
+    }
+    if (!fs::is_regular_file(file)) {
+      throw InputError(fmt::format("--in-situ: no scene file '{}'", file));
+    }
+    scenes.emplace_back(file, frames);
   }
   fs::path md_path = a.out.empty() ? fs::path("docs/results/in_situ.md") : fs::path(a.out);
   if (fs::is_directory(md_path) || md_path.extension() != ".md") md_path /= "in_situ.md";
@@ -281,33 +307,34 @@ int run_in_situ(const InSituArgs& a) {
   }
   const std::string load_before = load_average();
   const std::string date = utc_now();
+  // The report is rewritten after every scene, so a run cut short keeps the scenes it finished.
   std::vector<SceneResult> results;
-  for (const auto& s : a.scenes)
-    results.push_back(run_scene(s, a.frames));
-  const std::string load_after = load_average();
-
-  const std::string header = fmt::format(
-      "# Self-CCD culling in situ\n\n"
-      "- command: `{}`\n"
-      "- commit: {}\n"
-      "- machine: {} cores ({}), {} worker threads\n"
-      "- date: {}\n"
-      "- load average (1, 5, 15 min): {} before, {} after\n"
-      "- per-frame figures: {}\n\n",
-      a.command, commit(), ::sysconf(_SC_NPROCESSORS_ONLN), cpu_model(),
-      a.threads > 0 ? fmt::format("{}", a.threads) : std::string("all"), date, load_before,
-      load_after, csv_path.filename().string());
-  std::string csv =
-      "scene,setting,frame,substeps,frame_s,collision_s,self_ccd_calls,triangle_pairs,"
-      "nodes_culled,refit_s,traversal_s,narrow_s,proximity_calls,proximity_reused_pairs,"
-      "proximity_pairs,proximity_s\n";
-  for (const SceneResult& r : results) {
-    for (const auto& row : r.csv_rows)
-      csv += row + "\n";
+  for (const auto& [file, frames] : scenes) {
+    results.push_back(run_scene(file, frames));
+    const std::string header = fmt::format(
+        "# Self-CCD culling in situ\n\n"
+        "- command: `{}`\n"
+        "- commit: {}\n"
+        "- machine: {} cores ({}), {} worker threads\n"
+        "- date: {}\n"
+        "- load average (1, 5, 15 min): {} before, {} after\n"
+        "- scenes: {} of {} done\n"
+        "- per-frame figures: {}\n\n",
+        a.command, commit(), ::sysconf(_SC_NPROCESSORS_ONLN), cpu_model(),
+        a.threads > 0 ? fmt::format("{}", a.threads) : std::string("all"), date, load_before,
+        load_average(), results.size(), scenes.size(), csv_path.filename().string());
+    std::string csv =
+        "scene,setting,frame,substeps,frame_s,collision_s,self_ccd_calls,triangle_pairs,"
+        "nodes_culled,refit_s,traversal_s,narrow_s,proximity_calls,proximity_reused_pairs,"
+        "proximity_pairs,proximity_s\n";
+    for (const SceneResult& r : results) {
+      for (const auto& row : r.csv_rows)
+        csv += row + "\n";
+    }
+    if (!md_path.parent_path().empty()) fs::create_directories(md_path.parent_path());
+    write_file_atomic(csv_path, csv);
+    write_file_atomic(md_path, report(a, results, header));
   }
-  if (!md_path.parent_path().empty()) fs::create_directories(md_path.parent_path());
-  write_file_atomic(csv_path, csv);
-  write_file_atomic(md_path, report(a, results, header));
   fmt::print("results in {} and {}\n", md_path.string(), csv_path.string());
   return 0;
 }

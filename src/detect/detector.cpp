@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "clearance.hpp"
@@ -124,29 +125,21 @@ struct SelfDetector::Impl {
     return reach * (1 + 1e-9) + detail::kClearanceRounding * scale;
   }
 
-  // The smallest corner clearance (docs/algorithms.md 1.6) of the triangles below each node over
-  // the current step; children come after their parent, so one reverse pass fills the nodes.
-  std::vector<double> node_clearance;
-  void update_clearances() {
-    const auto& nodes = bvh.nodes();
+  // The smallest corner clearance (docs/algorithms.md 1.6) over the current step of the
+  // triangles below node n, or a value at most `floor` once one is found below it. Computed only
+  // for the nodes the traversal asks about (their cones and contours passed), and the nodes it
+  // culls are disjoint, so a pass visits few triangles more than once.
+  [[nodiscard]] double corner_clearance(const BvhNode& n, double floor) const {
     const auto& prims = bvh.prim_ids();
     const auto& faces = topo.faces();
-    node_clearance.resize(nodes.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes.size(), 1024),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          if (!nodes[i].is_leaf()) continue;
-                          const Face& f = faces[prims[nodes[i].first]];
-                          node_clearance[i] = detail::triangle_corner_clearance(
-                              detail::corners(v0, f), detail::corners(v1, f));
-                        }
-                      });
-    for (std::size_t i = nodes.size(); i-- > 0;) {
-      const BvhNode& n = nodes[i];
-      if (!n.is_leaf()) {
-        node_clearance[i] = std::min(node_clearance[n.left], node_clearance[n.left + 1]);
-      }
+    double clearance = std::numeric_limits<double>::infinity();
+    for (int k = n.first; k < n.first + n.count; ++k) {
+      const Face& f = faces[prims[k]];
+      clearance = std::min(clearance, detail::triangle_corner_clearance(detail::corners(v0, f),
+                                                                        detail::corners(v1, f)));
+      if (!(clearance > floor)) break;
     }
+    return clearance;
   }
 
   [[nodiscard]] bool vf_in_scope(int v, int f) const {
@@ -179,7 +172,8 @@ struct SelfDetector::Impl {
       if (ok && with_reach) {
         // Projected distances are at least cos(half angle) times the 3-D corner clearances.
         const double reach = cull_reach(n);
-        ok = std::cos(k.half_angle) * node_clearance[i] > reach &&
+        const double cosine = std::cos(k.half_angle);
+        ok = cosine * corner_clearance(n, reach / cosine) > reach &&
              detail::contour_clear(bvh.contour(i), v0, v1, k.axis, reach);
       }
       if (!ok) ++c.contour_fails;
@@ -356,7 +350,6 @@ struct SelfDetector::Impl {
     ro.cones = cones_used(opt.culling);
     ro.policy = opt.policy;
     bvh.refit_changed(v0, v1, ro);
-    if (culls_with_reach()) update_clearances();
     st.time_refit = seconds_since(t);
     st.internal_nodes = bvh.num_internal();
     st.connected_internal_nodes = bvh.num_connected_internal();

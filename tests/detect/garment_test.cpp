@@ -1,11 +1,13 @@
 // Sewn garments: the patch BVH keeps at least 99% of its
 // internal nodes edge-connected; on a step from the drape to a smoothly perturbed pose the sound
 // culling finds exactly what the unculled traversal finds in every policy and build, and on the
-// dress it culls at least half as many triangle pairs as the paper's cone-only rule.
+// dress it culls at least half as many triangle pairs as the paper's cone-only rule; with the
+// simulator's thickness and proximity reuse it stays exact, the query after it included.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 
 #include "clothcd/detect/detector.hpp"
@@ -109,6 +111,61 @@ TEST(Garments, MultilayerPatchConnectedAndSoundExact) {
   EXPECT_GT(r.vf.size() + r.ee.size() + r.missed_vf.size() + r.missed_ee.size(), 0u);
   EXPECT_TRUE(r.missed_vf.empty());
   EXPECT_TRUE(r.missed_ee.empty());
+}
+
+// The simulator's settings on the dress: a CCD thickness, pairs kept for a proximity query at a
+// reuse distance, a substep-sized step (2 mm). Sound culling under each policy reports exactly
+// what the unculled traversal reports, and the query after it (at the step's end, then with a
+// patch of vertices moved) exactly what an unculled detector without reuse finds, distances
+// included.
+TEST(Garments, DressSoundWithThicknessAndReuseExact) {
+  CLOTHCD_REQUIRE_DATA(root, "garments/dress_knife/drape.obj");
+  const Garment g = load(root, 15656, 29456, 0.002);
+  const double reuse = 1e-3;
+  DetectOptions plain;
+  plain.thickness = 1e-5;
+  plain.build = BvhBuild::Patch;
+  SelfDetector ref(g.sewn.faces, g.sewn.num_vertices(), g.p0, plain);
+  Positions shifted = g.p1;
+  for (Eigen::Index i = 0; i < shifted.rows(); i += 7)
+    shifted(i, 1) += 3e-4;
+  const ProximityResult ref_end = ref.proximity(g.p1, reuse);
+  const ProximityResult ref_shifted = ref.proximity(shifted, reuse);
+  ASSERT_GT(ref_end.vf.size() + ref_end.ee.size(), 0u);
+  std::uint64_t culled = 0;
+  for (ConePolicy policy : {ConePolicy::Provot, ConePolicy::Proposed}) {
+    SCOPED_TRACE(::testing::Message() << "policy " << int(policy));
+    DetectOptions o = plain;
+    o.culling = Culling::Sound;
+    o.policy = policy;
+    o.reuse_distance = reuse;
+    o.verify = true;
+    SelfDetector det(g.sewn.faces, g.sewn.num_vertices(), g.p0, o);
+    const DetectResult r = det.detect(g.p0, g.p1);
+    ASSERT_TRUE(r.verified);
+    EXPECT_TRUE(r.missed_vf.empty());
+    EXPECT_TRUE(r.missed_ee.empty());
+    culled += r.stats.nodes_culled;
+    for (const Positions* at : std::array<const Positions*, 2>{&g.p1, &shifted}) {
+      static_cast<void>(det.detect(g.p0, g.p1));
+      const ProximityResult p = det.proximity(*at, reuse);
+      const ProximityResult& want = at == &g.p1 ? ref_end : ref_shifted;
+      EXPECT_GT(p.reused_pairs, 0u);
+      ASSERT_EQ(p.vf.size(), want.vf.size());
+      ASSERT_EQ(p.ee.size(), want.ee.size());
+      for (std::size_t i = 0; i < p.vf.size(); ++i) {
+        EXPECT_EQ(p.vf[i].vertex, want.vf[i].vertex);
+        EXPECT_EQ(p.vf[i].face, want.vf[i].face);
+        EXPECT_EQ(p.vf[i].distance, want.vf[i].distance);
+      }
+      for (std::size_t i = 0; i < p.ee.size(); ++i) {
+        EXPECT_EQ(p.ee[i].edge_a, want.ee[i].edge_a);
+        EXPECT_EQ(p.ee[i].edge_b, want.ee[i].edge_b);
+        EXPECT_EQ(p.ee[i].distance, want.ee[i].distance);
+      }
+    }
+  }
+  EXPECT_GT(culled, 0u);  // the cones were in the loop
 }
 
 }  // namespace

@@ -87,6 +87,31 @@ TEST(InSitu, BadInputWritesNothing) {
   EXPECT_NE(plain.code, 0);
   EXPECT_NE(plain.err.find("plain.json"), std::string::npos) << plain.err;
   EXPECT_EQ(dir.files(), std::vector<std::string>{"plain.json"});
+  // SCENE@N needs a positive frame count.
+  dir.write("s.json", kScene);
+  for (const char* bad : {"s.json@", "s.json@0", "s.json@2x"}) {
+    const auto r = dir.run(std::string("experiment --in-situ ") + bad + " --frames 2 --out res");
+    EXPECT_NE(r.code, 0) << bad;
+    EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(dir.files(), (std::vector<std::string>{"plain.json", "s.json"}));
+}
+
+// SCENE@N runs at most N frames of that scene (and never more than --frames).
+TEST(InSitu, SceneFrameCaps) {
+  CliScratch dir;
+  dir.write("s.json", kScene);
+  const auto r = dir.run("experiment --in-situ s.json@1 s.json@5 --frames 2 --threads 1 --out res");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::stringstream csv(CliScratch::slurp(dir / "res/in_situ.csv"));
+  std::string line;
+  ASSERT_TRUE(std::getline(csv, line));
+  int rows = 0;
+  while (std::getline(csv, line))
+    ++rows;
+  EXPECT_EQ(rows, 4 * (1 + 2));  // four settings, 1 + 2 frames
+  const std::string md = CliScratch::slurp(dir / "res/in_situ.md");
+  EXPECT_NE(md.find("- scenes: 2 of 2 done"), std::string::npos) << md;
 }
 
 }  // namespace

@@ -86,8 +86,10 @@ struct ContactOptions {
   /// cone rules are refused by the scene parser. Both find the same pairs, so the motion is
   /// bitwise the same (tested); only the time and the figures of SelfCcdFigures differ. None is
   /// the default because at the garment scenes' settings the cones cost more than they save
-  /// (docs/results/in_situ.md: they cull 10-13% of the dresses' pair tests, while computing them
-  /// makes each full pass's refit several times dearer).
+  /// (docs/results/in_situ.md): a substep moves the cloth so little that few of a full pass's
+  /// pair tests lie inside a patch the cones can clear (on the multilayer garments most are
+  /// between layers), while refitting the cones makes each full pass's refit several times
+  /// dearer.
   Culling culling = Culling::None;
   /// The normal cones the sound culling uses (no effect without culling): Provot, Proposed or
   /// Exact. Again only the time and the figures change, never the motion.

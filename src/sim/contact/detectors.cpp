@@ -19,6 +19,10 @@ SelfDetector& ContactDetectors::start_self(const ContactGeometry& g) {
     // Never the unsound cone rules in the simulator: None or Sound find the same pairs.
     o.culling = opt_.culling == Culling::None ? Culling::None : Culling::Sound;
     o.policy = opt_.cone_policy;
+    // The patch build: cones cull only nodes whose triangles form a disk, which median splits
+    // rarely make, and its subtrees follow the surface, so the unculled traversal and the
+    // proximity query are faster on it too (the pairs found are the same).
+    o.build = BvhBuild::Patch;
     // The proximity query (at the repulsion distance) then reuses the last CCD pass's pairs.
     o.reuse_distance = opt_.thickness;
     // Seam-linked vertices count as one point: the seam's sides touch by design.
