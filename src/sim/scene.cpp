@@ -11,6 +11,7 @@
 #include <set>
 
 #include "clothcd/core/error.hpp"
+#include "clothcd/detect/names.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/sim/sewing.hpp"
 
@@ -449,16 +450,11 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     c.coupled_contacts = o.boolean("coupled_contacts", c.coupled_contacts);
     c.full_passes = o.boolean("full_passes", c.full_passes);
     c.untangle_step = o.number("untangle_step", c.untangle_step, 0.0, 1.0);
-    c.culling = o.string("culling", c.culling == Culling::None ? "none" : "sound",
-                         {"none", "sound"}) == "none"
-                    ? Culling::None
-                    : Culling::Sound;
-    {
-      const std::string p = o.string("cone_policy", "proposed", {"provot", "proposed", "exact"});
-      c.cone_policy = p == "provot"  ? ConePolicy::Provot
-                      : p == "exact" ? ConePolicy::Exact
-                                     : ConePolicy::Proposed;
-    }
+    // Only the exact settings: a simulator must not lose collisions to an unsound rule.
+    c.culling =
+        parse_culling(o.string("culling", std::string(to_string(c.culling)), {"none", "sound"}));
+    c.cone_policy = parse_cone_policy(o.string("cone_policy", std::string(to_string(c.cone_policy)),
+                                               {"provot", "proposed", "exact"}));
     c.affine_zones = o.string("zone_motion", c.affine_zones ? "affine" : "rigid",
                               {"rigid", "affine"}) == "affine";
     s.repair_initial_crossings = o.boolean("repair_initial_crossings", s.repair_initial_crossings);
