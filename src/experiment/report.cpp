@@ -2,8 +2,10 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
+
 #include <cstdlib>
 #include <map>
 #include <numeric>
@@ -477,6 +479,13 @@ std::string timing_table(const std::vector<SceneData>& data, const ExperimentOpt
     s += fmt::format(
         "Timed steps: {} ({}); load {:.2f}-{:.2f}.\n\n", steps.size(),
         steps.size() <= 12 ? fmt::format("{}", fmt::join(steps, ", ")) : "see timing.csv", lo, hi);
+    if (const long cores = ::sysconf(_SC_NPROCESSORS_ONLN); cores > 0 && hi > double(cores)) {
+      s += fmt::format(
+          "**Shared machine: the load reached {:.2f} on {} cores while this scene was timed, so "
+          "other processes took turns on the cores; every time below is noisy, the ratios to "
+          "PROVOT (paired call by call) less so.**\n\n",
+          hi, cores);
+    }
     s += "| build | culling | policy | threads | calls | median total | p25-p75 | median refit | "
          "median CD | / PROVOT | |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     const auto agg = timing_aggs(d);
