@@ -21,6 +21,8 @@
 #   TIMING_THREADS    thread counts of the timing pass (default "1 2")
 #   INSITU_FRAMES     frames per garment of the in-situ comparison (default 6; 0: skip it)
 #   COPY              1: copy the outputs to docs/results/ (default 1)
+#   SIMULATE          0: simulate nothing, run on the frames OUT/frames already holds (a scene's
+#                     complete frames only; the tables then say how many calls of the whole)
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -45,6 +47,7 @@ timing_repeats=${TIMING_REPEATS:-3}
 read -r -a timing_threads <<<"${TIMING_THREADS:-1 2}"
 insitu_frames=${INSITU_FRAMES:-6}
 copy=${COPY:-1}
+simulate=${SIMULATE:-1}
 
 if [[ ! -x $bin ]]; then
   cmake -S "$root" -B "$root/build/release" -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -81,7 +84,20 @@ part() {
 }
 
 scenes=(dress-rumba dress-kick multilayer-rumba multilayer-kick sphere-drop twist)
+# window[NAME]: "" (the whole sequence) or "@N" (the N calls OUT/frames holds, SIMULATE=0).
+declare -A window
 for s in "${scenes[@]}"; do
+  window[$s]=""
+  if [[ $simulate == 0 ]]; then
+    n=$(sed -n 's/^ *"complete_frames": *\([0-9]*\).*/\1/p' "$out/frames/$s/manifest.json" 2>/dev/null |
+      head -1)
+    if [[ -z $n || $n -lt 1 ]]; then
+      echo "results.sh: SIMULATE=0 but $out/frames/$s holds no complete frame pair" >&2
+      exit 1
+    fi
+    window[$s]="@$n"
+    continue
+  fi
   resume=()
   [[ -f $out/frames/$s/manifest.json ]] && resume=(--resume)
   part "simulate $s" "$bin" simulate "$root/scenes/$s.json" --out "$out/frames/$s" \
@@ -90,14 +106,16 @@ done
 
 # One experiment call per scene (results accumulate in OUT/runs/), then one over all of them
 # that finds everything done and writes the tables and figures.
-specs=(fold stacked_sheets winding_strip crumpled_sheet twisted_strip cloth_ball sphere-drop twist
-  "dress-rumba%$dress_every" "dress-kick%$dress_every" "multilayer-rumba%$multi_every"
-  "multilayer-kick%$multi_every")
+specs=(fold stacked_sheets winding_strip crumpled_sheet twisted_strip cloth_ball
+  "sphere-drop${window[sphere-drop]}" "twist${window[twist]}"
+  "dress-rumba${window[dress-rumba]}%$dress_every" "dress-kick${window[dress-kick]}%$dress_every"
+  "multilayer-rumba${window[multilayer-rumba]}%$multi_every"
+  "multilayer-kick${window[multilayer-kick]}%$multi_every")
 common=(--out "$out" --threads "$threads" --optimal-every "$optimal_every"
   --timing-every "$timing_every" --timing-repeats "$timing_repeats"
   --timing-threads "${timing_threads[@]}" --timing-cullings cone sound)
 for s in "${specs[@]}"; do
-  part "experiment ${s%%%*}" "$bin" experiment --scene "$s" "${common[@]}" --no-plots
+  part "experiment ${s%%[@%]*}" "$bin" experiment --scene "$s" "${common[@]}" --no-plots
 done
 part "tables and figures" "$bin" experiment --scene "${specs[@]}" "${common[@]}"
 
