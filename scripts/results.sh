@@ -15,6 +15,8 @@
 #   THREADS           worker threads of the simulations and the counting pass (default 2)
 #   DRESS_EVERY       run every E-th CD call of the dress scenes (default 1: all 120)
 #   MULTI_EVERY       the same for the multilayer scenes (default 2)
+#   OTHER_EVERY       the same for sphere-drop and twist (default 1)
+#   EVERY_<scene>     the same for one scene, '-' written '_' (e.g. EVERY_dress_kick=4)
 #   OPTIMAL_EVERY     OPTIMAL spread angles on every K-th call run (default 1)
 #   TIMING_EVERY      timing pass on every T-th call run (default 20)
 #   TIMING_REPEATS    calls per configuration and thread count in the timing pass (default 3)
@@ -41,6 +43,7 @@ bin=${CLOTHCD_BIN:-$root/build/release/apps/clothcd}
 threads=${THREADS:-2}
 dress_every=${DRESS_EVERY:-1}
 multi_every=${MULTI_EVERY:-2}
+other_every=${OTHER_EVERY:-1}
 optimal_every=${OPTIMAL_EVERY:-1}
 timing_every=${TIMING_EVERY:-20}
 timing_repeats=${TIMING_REPEATS:-3}
@@ -63,6 +66,7 @@ load() { cut -d' ' -f1-3 /proc/loadavg; }
   echo "- machine: $(nproc) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'))"
   echo "- date: $(date -u '+%Y-%m-%d %H:%M:%S UTC')"
   echo "- settings: THREADS=$threads DRESS_EVERY=$dress_every MULTI_EVERY=$multi_every" \
+    "OTHER_EVERY=$other_every $(env | grep '^EVERY_' | tr '\n' ' ')SIMULATE=$simulate" \
     "OPTIMAL_EVERY=$optimal_every TIMING_EVERY=$timing_every TIMING_REPEATS=$timing_repeats" \
     "TIMING_THREADS='${timing_threads[*]}' INSITU_FRAMES=$insitu_frames"
   echo "- a part whose output OUT already held takes only the time to check it"
@@ -106,11 +110,15 @@ done
 
 # One experiment call per scene (results accumulate in OUT/runs/), then one over all of them
 # that finds everything done and writes the tables and figures.
+# spec NAME DEFAULT_EVERY: the scene's --scene argument.
+spec() {
+  local var="EVERY_${1//-/_}"
+  echo "$1${window[$1]}%${!var:-$2}"
+}
 specs=(fold stacked_sheets winding_strip crumpled_sheet twisted_strip cloth_ball
-  "sphere-drop${window[sphere-drop]}" "twist${window[twist]}"
-  "dress-rumba${window[dress-rumba]}%$dress_every" "dress-kick${window[dress-kick]}%$dress_every"
-  "multilayer-rumba${window[multilayer-rumba]}%$multi_every"
-  "multilayer-kick${window[multilayer-kick]}%$multi_every")
+  "$(spec sphere-drop "$other_every")" "$(spec twist "$other_every")"
+  "$(spec dress-rumba "$dress_every")" "$(spec dress-kick "$dress_every")"
+  "$(spec multilayer-rumba "$multi_every")" "$(spec multilayer-kick "$multi_every")")
 common=(--out "$out" --threads "$threads" --optimal-every "$optimal_every"
   --timing-every "$timing_every" --timing-repeats "$timing_repeats"
   --timing-threads "${timing_threads[@]}" --timing-cullings cone sound)
