@@ -417,6 +417,7 @@ std::string spread_table(const std::vector<SceneData>& data, const ExperimentOpt
 // (same step, repeat and thread count), the ratio to PROVOT under the same rule.
 struct TimingAgg {
   std::vector<double> total, refit, cd, ratio;
+  std::map<int, std::vector<double>> step_totals;  ///< the repeats of each timed step
 };
 using TimingKey = std::tuple<std::string, std::string, std::string, int>;
 
@@ -430,6 +431,7 @@ std::map<TimingKey, TimingAgg> timing_aggs(const SceneData& d) {
   for (const auto& r : d.timing) {
     TimingAgg& a = out[{r.build, r.culling, r.policy, r.threads}];
     a.total.push_back(r.ms_total());
+    a.step_totals[r.step].push_back(r.ms_total());
     a.refit.push_back(r.ms_refit);
     a.cd.push_back(r.ms_traverse + r.ms_narrow);
     const auto it = provot.find({r.build, r.culling, r.step, r.repeat, r.threads});
@@ -440,8 +442,21 @@ std::map<TimingKey, TimingAgg> timing_aggs(const SceneData& d) {
   return out;
 }
 
-// A figure is flagged noisy when its interquartile range exceeds a fifth of its median.
+// A figure is flagged noisy when the same call, repeated, varies by more than a fifth of its
+// median (the steps differ in cost by themselves, so the spread over all calls would not say).
 constexpr double kNoisy = 0.2;
+
+// Median over the timed steps of (max - min) / median of that step's repeats.
+double repeat_spread(const TimingAgg& a) {
+  std::vector<double> v;
+  for (const auto& [step, t] : a.step_totals) {
+    const double m = median(t);
+    if (t.size() >= 2 && m > 0)
+      v.push_back((*std::max_element(t.begin(), t.end()) - *std::min_element(t.begin(), t.end())) /
+                  m);
+  }
+  return median(v);
+}
 
 bool noisy(const std::vector<double>& v) {
   const double m = median(v);
@@ -455,10 +470,12 @@ std::string timing_table(const std::vector<SceneData>& data, const ExperimentOpt
       "(the unculled reference and every policy under the timed rules) {} times under each thread "
       "count, repeat by repeat, thread count by thread count, with the configurations in an "
       "order rotated per repeat, all on the same frame pair. *total* = refit + traversal + "
-      "narrow phase; p25-p75 = interquartile range over those calls; */ PROVOT* = median of "
+      "narrow phase; p25-p75 = interquartile range over those calls (the steps differ in cost by "
+      "themselves); *repeat spread* = the median over the timed steps of (max - min) / median of "
+      "one step's repeats, the noise of the machine; */ PROVOT* = median of "
       "the ratio to PROVOT's total of the same call (same step, repeat and thread count, same "
-      "build and rule): below 1 = faster. A figure is marked *noisy* when its interquartile "
-      "range exceeds {:.0f}% of its median. *load* = the 1-minute load average read before "
+      "build and rule): below 1 = faster. A row is marked *noisy* when its repeat spread "
+      "exceeds {:.0f}%. *load* = the 1-minute load average read before "
       "each timed step (min-max); on a machine with as many cores as threads in use, anything "
       "above the thread count means other processes shared the cores.\n\n",
       opt.timing_every == 1 ? std::string("every CD call")
@@ -486,19 +503,24 @@ std::string timing_table(const std::vector<SceneData>& data, const ExperimentOpt
           "PROVOT (paired call by call) less so.**\n\n",
           hi, cores);
     }
-    s += "| build | culling | policy | threads | calls | median total | p25-p75 | median refit | "
-         "median CD | / PROVOT | |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    s += "| build | culling | policy | threads | calls | median total | p25-p75 | repeat spread | "
+         "median refit | median CD | / PROVOT | "
+         "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     const auto agg = timing_aggs(d);
     for (const auto& k : config_order(opt)) {
       for (int t = 1; t <= 1024; ++t) {
         const auto it = agg.find({k.build, k.culling, k.policy, t});
         if (it == agg.end()) continue;
         const TimingAgg& a = it->second;
-        const bool n = noisy(a.total) || (!a.ratio.empty() && noisy(a.ratio));
+        const double spread = repeat_spread(a);
+        const bool n = !(spread <= kNoisy);
         s += fmt::format(
-            "| {} | {} | {} | {} | {} | {:.2f} | {:.2f}-{:.2f} | {:.2f} | {:.2f} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {:.2f} | {:.2f}-{:.2f} | {} | {:.2f} | {:.2f} | {} | {} "
+            "|\n",
             k.build, k.culling, k.policy, t, a.total.size(), median(a.total),
-            quantile(a.total, 0.25), quantile(a.total, 0.75), median(a.refit), median(a.cd),
+            quantile(a.total, 0.25), quantile(a.total, 0.75),
+            std::isnan(spread) ? std::string("-") : fmt::format("{:.0f}%", 100 * spread),
+            median(a.refit), median(a.cd),
             a.ratio.empty() ? std::string("-") : fmt::format("{:.3f}", median(a.ratio)),
             n ? "noisy" : "");
       }
