@@ -133,6 +133,28 @@ if [[ $insitu_frames -gt 0 ]]; then
     --frames "$insitu_frames" --threads "$threads" --out "$out/in_situ.md"
 fi
 
+# What the simulations cost when they ran (also for frames an earlier run made): their manifests.
+/usr/bin/python3 - "$out/frames" "${scenes[@]}" >>"$times" <<'PY'
+import json, os, sys
+root, names = sys.argv[1], sys.argv[2:]
+print("\nSimulation cost recorded in each scene's manifest (the run that made the frames, whatever "
+      "else loaded the machine then):\n")
+print("| scene | frames | s total | s per frame (median) | self crossing pairs, worst frame |")
+print("|---|---|---|---|---|")
+for n in names:
+    try:
+        m = json.load(open(os.path.join(root, n, "manifest.json")))
+    except OSError:
+        continue
+    fr = m.get("frames", [])
+    secs = sorted(f.get("seconds", 0.0) for f in fr)
+    worst = max([m.get("initial_self_intersections", 0)] +
+                [f.get("self_intersections", 0) for f in fr])
+    med = secs[len(secs) // 2] if secs else float("nan")
+    print("| %s | %d | %.0f | %.1f | %d |" % (n, m.get("complete_frames", 0), sum(secs), med, worst))
+print()
+PY
+
 if [[ $copy == 1 ]]; then
   files=(summary.md table1.md table2.md timing.md misses.md spread.md fig5.png fig6.png run_times.md)
   [[ $insitu_frames -gt 0 ]] && files+=(in_situ.md)
