@@ -23,6 +23,8 @@
 #   TIMING_THREADS    thread counts of the timing pass (default "1 2")
 #   INSITU_FRAMES     frames per garment of the in-situ comparison (default 6; 0: skip it)
 #   COPY              1: copy the outputs to docs/results/ (default 1)
+#   OTHERS            the recorded and procedural sequences (default: fold stacked_sheets
+#                     winding_strip crumpled_sheet twisted_strip cloth_ball)
 #   SIMULATE          0: simulate nothing, run on the frames OUT/frames already holds (a scene's
 #                     complete frames only; the tables then say how many calls of the whole)
 set -euo pipefail
@@ -66,7 +68,7 @@ load() { cut -d' ' -f1-3 /proc/loadavg; }
   echo "- machine: $(nproc) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'))"
   echo "- date: $(date -u '+%Y-%m-%d %H:%M:%S UTC')"
   echo "- settings: THREADS=$threads DRESS_EVERY=$dress_every MULTI_EVERY=$multi_every" \
-    "OTHER_EVERY=$other_every $(env | grep '^EVERY_' | tr '\n' ' ')SIMULATE=$simulate" \
+    "OTHER_EVERY=$other_every OTHERS='${OTHERS:-(default)}' $(env | grep '^EVERY_' | tr '\n' ' ')SIMULATE=$simulate" \
     "OPTIMAL_EVERY=$optimal_every TIMING_EVERY=$timing_every TIMING_REPEATS=$timing_repeats" \
     "TIMING_THREADS='${timing_threads[*]}' INSITU_FRAMES=$insitu_frames"
   echo "- a part whose output OUT already held takes only the time to check it"
@@ -115,7 +117,8 @@ spec() {
   local var="EVERY_${1//-/_}"
   echo "$1${window[$1]}%${!var:-$2}"
 }
-specs=(fold stacked_sheets winding_strip crumpled_sheet twisted_strip cloth_ball
+read -r -a others <<<"${OTHERS:-fold stacked_sheets winding_strip crumpled_sheet twisted_strip cloth_ball}"
+specs=("${others[@]}"
   "$(spec sphere-drop "$other_every")" "$(spec twist "$other_every")"
   "$(spec dress-rumba "$dress_every")" "$(spec dress-kick "$dress_every")"
   "$(spec multilayer-rumba "$multi_every")" "$(spec multilayer-kick "$multi_every")")
