@@ -236,7 +236,7 @@ int run(const Args& a) {
                                   : std::string("all cores (counting pass)"));
   if (a.timing_every > 0) {
     opt.stamp +=
-        fmt::format("- timing pass: every {}th CD call run, {} repeats, threads {}\n",
+        fmt::format("- timing pass: every {}-th CD call run, {} repeats, threads {}\n",
                     a.timing_every, a.timing_repeats, fmt::join(a.timing_threads, " and "));
   }
   std::optional<tbb::global_control> limit;
@@ -264,7 +264,7 @@ int run(const Args& a) {
     total += (q.steps() + q.every - 1) / q.every * static_cast<int>(opt.builds.size());
   fmt::print(stderr,
              "{} configurations + the unculled reference per build, {} CD steps; OPTIMAL spread "
-             "angles on every {}th step\n",
+             "angles on every {}-th step\n",
              opt.policies.size() * opt.cullings.size() * opt.builds.size(), total,
              opt.optimal_every);
   Bar bar;

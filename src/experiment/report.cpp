@@ -175,6 +175,17 @@ SceneData collect(const Sequence& seq, const ExperimentOptions& opt) {
   return d;
 }
 
+// "2nd", "3rd", "4th", "11th", "21st".
+std::string ordinal(int n) {
+  const int t = n % 100;
+  const char* suffix = (t >= 11 && t <= 13) ? "th"
+                       : n % 10 == 1        ? "st"
+                       : n % 10 == 2        ? "nd"
+                       : n % 10 == 3        ? "rd"
+                                            : "th";
+  return fmt::format("{}{}", n, suffix);
+}
+
 // CD calls run of a sequence (Sequence::every).
 int calls_run(const Sequence& seq, const ExperimentOptions& /*opt*/) {
   const int e = std::max(1, seq.every);
@@ -185,7 +196,7 @@ std::string calls_text(const Sequence& seq, const ExperimentOptions& opt) {
   const int run = calls_run(seq, opt);
   return run == seq.steps()
              ? fmt::format("{} CD calls", run)
-             : fmt::format("{} of its {} CD calls: every {}th", run, seq.steps(), seq.every);
+             : fmt::format("{} of its {} CD calls: every {}", run, seq.steps(), ordinal(seq.every));
 }
 
 std::string scene_heading(const SceneData& d, const ExperimentOptions& opt) {
@@ -479,7 +490,7 @@ std::string timing_table(const std::vector<SceneData>& data, const ExperimentOpt
       "each timed step (min-max); on a machine with as many cores as threads in use, anything "
       "above the thread count means other processes shared the cores.\n\n",
       opt.timing_every == 1 ? std::string("every CD call")
-                            : fmt::format("every {}th CD call", opt.timing_every),
+                            : fmt::format("every {} CD call", ordinal(opt.timing_every)),
       opt.timing_repeats, 100 * kNoisy);
   bool any = false;
   for (const auto& d : data) {

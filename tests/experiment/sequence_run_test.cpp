@@ -96,7 +96,7 @@ TEST(ExperimentSequence, EveryEthCallRunsThoseFramePairsOnly) {
   write_reports({strided}, opt);
   const std::string summary = slurp(opt.out / "summary.md");
   EXPECT_NE(summary.find("| fold | 128 | 6 | 5 | 3 |"), std::string::npos) << summary;
-  EXPECT_NE(slurp(opt.out / "table1.md").find("3 of its 5 CD calls: every 2th"), std::string::npos);
+  EXPECT_NE(slurp(opt.out / "table1.md").find("3 of its 5 CD calls: every 2nd"), std::string::npos);
   fs::remove_all(opt.out);
 }
 
