@@ -4,8 +4,9 @@ OUT/spread.csv.
 
     /usr/bin/python3 scripts/plot_experiment.py OUT
 
-fig5.png: spread angle of the tracked BVH node over the steps, PROVOT / PROPOSED / EXACT / OPTIMAL
-(one row per scene, one column per BVH build). fig6.png: triangle pair tests per step, one row per
+fig5.png: spread angle of the tracked BVH node over the steps, PROVOT / PROPOSED / EXACT / OPTIMAL,
+and beside it the mean half-angle over all internal nodes (those with a non-saturated OPTIMAL cone)
+relative to OPTIMAL's (one row per scene, two columns per BVH build). fig6.png: triangle pair tests per step, one row per
 scene, one column per culling rule, one line per policy and build (the unculled reference dashed).
 Needs Debian's python3-matplotlib (call /usr/bin/python3, not another python3 on the PATH).
 """
@@ -56,14 +57,18 @@ def fig5(spread, out):
     builds = ordered({r["build"] for r in spread}, ["spatial", "patch"])
     if not scenes:
         return False
-    fig, axes = plt.subplots(len(scenes), len(builds), figsize=(6.2 * len(builds), 3.0 * len(scenes)),
-                             squeeze=False)
+    # Per build: the tracked node's angle, then the all-node ratio to OPTIMAL.
+    fig, axes = plt.subplots(len(scenes), 2 * len(builds),
+                             figsize=(5.0 * 2 * len(builds), 3.0 * len(scenes)), squeeze=False)
     for i, scene in enumerate(scenes):
         for j, build in enumerate(builds):
-            ax = axes[i][j]
+            ax = axes[i][2 * j]
+            rax = axes[i][2 * j + 1]
             rows = [r for r in spread if r["scene"] == scene and r["build"] == build]
             node = rows[0]["node"] if rows else "?"
             depth = rows[0]["node_depth"] if rows else "?"
+            opt = {int(r["step"]): float(r["opt_domain_mean_deg"]) for r in rows
+                   if r["policy"] == "OPTIMAL"}
             for policy in ordered({r["policy"] for r in rows}, ["PROVOT", "PROPOSED", "EXACT", "OPTIMAL"]):
                 # Saturated cones (>= 90 deg, stored larger by older runs) are drawn at 90.
                 pts = sorted((int(r["step"]), min(90.0, float(r["node_angle_deg"])))
@@ -71,20 +76,35 @@ def fig5(spread, out):
                 if not pts:
                     continue
                 xs, ys = zip(*pts)
-                # EXACT dashed so PROPOSED stays visible where they coincide; OPTIMAL is only
-                # computed on some steps: markers joined by a dotted line.
+                # EXACT dashed so PROPOSED stays visible where they coincide.
                 style = {"EXACT": "--", "OPTIMAL": ":"}.get(policy, "-")
+                sparse = len(xs) < 12 or (policy == "OPTIMAL" and len(xs) < len(
+                    {int(r["step"]) for r in rows}))
                 ax.plot(xs, ys, style, color=COLORS.get(policy, "k"), label=policy,
-                        marker="o" if policy == "OPTIMAL" or len(xs) < 12 else None, markersize=3.5,
+                        marker="o" if sparse else None, markersize=3.5,
                         linewidth=2.0 if policy == "OPTIMAL" else 1.4)
+                if policy == "OPTIMAL" or not opt:
+                    continue
+                rpts = sorted((int(r["step"]), float(r["opt_domain_mean_deg"]) / opt[int(r["step"])])
+                              for r in rows if r["policy"] == policy and int(r["step"]) in opt
+                              and opt[int(r["step"])] > 0
+                              and r["opt_domain_mean_deg"] not in ("nan", ""))
+                if rpts:
+                    rx, ry = zip(*rpts)
+                    rax.plot(rx, ry, style, color=COLORS.get(policy, "k"), label=policy,
+                             marker="o" if len(rx) < 12 else None, markersize=3.5, linewidth=1.4)
             ax.set_title("%s, %s build: node %s (depth %s)" % (scene, build, node, depth), fontsize=9)
-            ax.xaxis.get_major_locator().set_params(integer=True)
-            ax.set_xlabel("CD call (step)")
-            ax.set_ylabel("spread angle (deg)")
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, loc="best")
-    fig.suptitle("Spread angle of one BVH node over the steps (cf. the paper's Figure 5); "
-                 "90 = saturated", fontsize=11)
+            rax.set_title("%s, %s build: all nodes, mean / OPTIMAL's" % (scene, build), fontsize=9)
+            rax.axhline(1.0, color=COLORS["OPTIMAL"], linestyle=":", linewidth=1.2)
+            for a, ylabel in ((ax, "spread angle (deg)"), (rax, "mean half-angle / OPTIMAL")):
+                a.xaxis.get_major_locator().set_params(integer=True)
+                a.set_xlabel("CD call (step)")
+                a.set_ylabel(ylabel)
+                a.grid(alpha=0.3)
+                a.legend(fontsize=7, loc="best")
+    fig.suptitle("Spread angle of one BVH node over the steps (cf. the paper's Figure 5), 90 = "
+                 "saturated; and the mean over the internal nodes whose OPTIMAL cone is not "
+                 "saturated, relative to OPTIMAL", fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 0.97))
     save(fig, os.path.join(out, "fig5.png"))
     return True

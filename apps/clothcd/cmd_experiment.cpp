@@ -4,6 +4,7 @@
 // python3-matplotlib). `clothcd experiment --in-situ SCENE.json... --frames N`: the self CCD's
 // culling settings inside the simulator instead (in_situ.cpp).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
 
@@ -43,6 +44,12 @@ struct Args {
   std::string scenes_dir;
   std::vector<std::string> in_situ;
   int frames = 6;
+  int every = 1;
+  int timing_every = 0;
+  int timing_repeats = 3;
+  std::vector<int> timing_threads{1, 2};
+  std::vector<std::string> timing_cullings{"cone", "gated", "sound"};
+  std::string command;
 };
 
 // The source tree (scenes/, scripts/): where the tool was built from, else the working folder.
@@ -96,17 +103,33 @@ class Bar {
 int parse_count(const std::string& text, const std::string& spec, int min) {
   if (text.empty() || text.size() > 6 ||
       text.find_first_not_of("0123456789") != std::string::npos || std::stoi(text) < min) {
-    throw InputError(fmt::format(
-        "--scene '{}': expected NAME@STEPS or NAME@FIRST:STEPS (STEPS >= 1, FIRST >= 0)", spec));
+    throw InputError(
+        fmt::format("--scene '{}': expected NAME@STEPS, NAME@FIRST:STEPS or a trailing %EVERY "
+                    "(STEPS, EVERY >= 1, FIRST >= 0)",
+                    spec));
   }
   return std::stoi(text);
 }
 
 Sequence resolve_scene_range(const std::string& s, const Args& a);
+Sequence resolve_scene_window(const std::string& spec, const Args& args);
 
 // `NAME@N`: at most N CD calls for that scene (overrides --steps); `NAME@F:N`: the N calls from
-// frame F on (the frames before F are simulated or read, then dropped).
-Sequence resolve_scene(const std::string& spec, const Args& args) {
+// frame F on (the frames before F are simulated or read, then dropped). A trailing `%E` runs
+// every E-th of those calls only (overrides --every).
+Sequence resolve_scene(const std::string& full, const Args& args) {
+  std::string spec = full;
+  int every = args.every;
+  if (const auto pc = spec.rfind('%'); pc != std::string::npos) {
+    every = parse_count(spec.substr(pc + 1), full, 1);
+    spec = spec.substr(0, pc);
+  }
+  Sequence q = resolve_scene_window(spec, args);
+  q.every = every;
+  return q;
+}
+
+Sequence resolve_scene_window(const std::string& spec, const Args& args) {
   const auto at = spec.rfind('@');
   if (at == std::string::npos) return resolve_scene_range(spec, args);
   Args a = args;
@@ -123,7 +146,7 @@ Sequence resolve_scene(const std::string& spec, const Args& args) {
     if (first + 1 >= static_cast<int>(q.frames.size())) {
       throw InputError(fmt::format("--scene '{}': only {} frames", spec, q.frames.size()));
     }
-    q.frames.erase(q.frames.begin(), q.frames.begin() + first);
+    drop_frames_before(q, first);
     // Another window is another scene: its results must not be reused for this one.
     q.name += fmt::format("-from{}", first);
     q.source += fmt::format(", from frame {}: step k = frames {}+k -> {}+k+1", first, first, first);
@@ -202,6 +225,20 @@ int run(const Args& a) {
   }
   opt.optimal_every = a.optimal_every;
   opt.optimal_max_faces = a.optimal_max_faces;
+  opt.timing_every = a.timing_every;
+  opt.timing_repeats = a.timing_repeats;
+  opt.timing_threads = a.timing_threads;
+  opt.timing_cullings.clear();
+  for (const auto& c : a.timing_cullings)
+    opt.timing_cullings.push_back(parse_culling(c, "--timing-cullings"));
+  opt.stamp = stamp(a.command, source_dir(),
+                    a.threads > 0 ? fmt::format("{} (counting pass)", a.threads)
+                                  : std::string("all cores (counting pass)"));
+  if (a.timing_every > 0) {
+    opt.stamp +=
+        fmt::format("- timing pass: every {}-th CD call run, {} repeats, threads {}\n",
+                    a.timing_every, a.timing_repeats, fmt::join(a.timing_threads, " and "));
+  }
   std::optional<tbb::global_control> limit;
   if (a.threads > 0) {
     limit.emplace(tbb::global_control::max_allowed_parallelism,
@@ -212,6 +249,7 @@ int run(const Args& a) {
   std::vector<Sequence> seqs;
   for (const auto& s : a.scenes) {
     seqs.push_back(resolve_scene(s, a));
+    count_crossings(seqs.back());
     for (std::size_t i = 0; i + 1 < seqs.size(); ++i) {
       if (seqs[i].name == seqs.back().name) {
         throw InputError(fmt::format("--scene: two scenes named '{}'", seqs.back().name));
@@ -223,10 +261,10 @@ int run(const Args& a) {
   }
   int total = 0;
   for (const auto& q : seqs)
-    total += q.steps() * static_cast<int>(opt.builds.size());
+    total += (q.steps() + q.every - 1) / q.every * static_cast<int>(opt.builds.size());
   fmt::print(stderr,
              "{} configurations + the unculled reference per build, {} CD steps; OPTIMAL spread "
-             "angles on every {}th step\n",
+             "angles on every {}-th step\n",
              opt.policies.size() * opt.cullings.size() * opt.builds.size(), total,
              opt.optimal_every);
   Bar bar;
@@ -234,7 +272,7 @@ int run(const Args& a) {
   for (const auto& q : seqs) {
     run_sequence(
         q, opt, [&bar](const Progress& p) { bar.update(p); }, done, total);
-    done += q.steps() * static_cast<int>(opt.builds.size());
+    done += (q.steps() + q.every - 1) / q.every * static_cast<int>(opt.builds.size());
     write_reports(seqs, opt);  // after each scene, so the tables cover what is finished
   }
   write_reports(seqs, opt);
@@ -266,7 +304,8 @@ const bool registered = clothcd::app::register_command(
                          "OUT/frames/NAME), scene .json file, cloth_ball, or a procedural sequence "
                          "(fold, stacked_sheets, winding_strip, crumpled_sheet, twisted_strip); "
                          "NAME@N: at most N "
-                         "CD calls for that scene");
+                         "CD calls for that scene, NAME@F:N the N calls from frame F on; a "
+                         "trailing %E runs every E-th of them only (e.g. dress-rumba%2)");
       sub.add_option("--out", a->out,
                      "output folder (results found there are reused); with --in-situ the "
                      "Markdown file or its folder (default docs/results/in_situ.md)");
@@ -290,13 +329,29 @@ const bool registered = clothcd::app::register_command(
       sub.add_option("--optimal-max-faces", a->optimal_max_faces,
                      "no OPTIMAL cones for scenes with more triangles than this (0: no limit)")
           ->check(CLI::NonNegativeNumber);
+      sub.add_option("--every", a->every,
+                     "run the CD calls 0, E, 2E, ... of each scene only (default 1: all; "
+                     "NAME%E sets it per scene)")
+          ->check(CLI::PositiveNumber);
+      sub.add_option("--timing-every", a->timing_every,
+                     "timing pass on every T-th run call: each configuration repeated, thread "
+                     "counts and configurations interleaved; medians in timing.md (0: none)")
+          ->check(CLI::NonNegativeNumber);
+      sub.add_option("--timing-repeats", a->timing_repeats,
+                     "calls per configuration and thread count in the timing pass (default 3)")
+          ->check(CLI::PositiveNumber);
+      sub.add_option("--timing-threads", a->timing_threads,
+                     "thread counts of the timing pass (default 1 2; capped by --threads)")
+          ->check(CLI::PositiveNumber);
+      sub.add_option("--timing-cullings", a->timing_cullings,
+                     "culling rules timed in the timing pass (default cone gated sound)");
       sub.add_flag("--no-plots", a->no_plots, "skip fig5.png / fig6.png");
       sub.add_option("--python", a->python,
                      "interpreter with matplotlib (default /usr/bin/python3)");
       sub.add_option("--plot-script", a->plot_script,
                      "plot script (default: scripts/plot_experiment.py of the source tree)");
       sub.add_option("--scenes-dir", a->scenes_dir, "folder of scene files (default: scenes/)");
-      return [a] {
+      return [a, &sub] {
         if (!a->in_situ.empty()) {
           clothcd::app::InSituArgs in;
           in.scenes = a->in_situ;
@@ -313,6 +368,14 @@ const bool registered = clothcd::app::register_command(
         }
         if (a->scenes.empty()) throw InputError("experiment: --scene or --in-situ is required");
         if (a->out.empty()) throw InputError("experiment: --out is required with --scene");
+        a->command = "clothcd experiment";
+        for (const auto& o : sub.get_options()) {
+          if (o->count() == 0 || o->get_name() == "--help") continue;
+          a->command += " " + o->get_name();
+          if (o->get_expected_min() == 0) continue;  // a flag: its name says it
+          for (const auto& r : o->results())
+            a->command += " " + r;
+        }
         return run(*a);
       };
     });

@@ -169,7 +169,39 @@ std::vector<SpreadRow> read_spread_rows(const std::filesystem::path& csv) {
   return rows;
 }
 
+std::vector<TimingRow> read_timing_rows(const std::filesystem::path& csv) {
+  const Table t(csv);
+  std::vector<TimingRow> rows(t.size());
+  for (std::size_t r = 0; r < t.size(); ++r) {
+    TimingRow& row = rows[r];
+    row.scene = t.text(r, "scene");
+    row.step = static_cast<int>(t.number(r, "step"));
+    row.build = t.text(r, "build");
+    row.culling = t.text(r, "culling");
+    row.policy = t.text(r, "policy");
+    row.threads = static_cast<int>(t.number(r, "threads"));
+    row.repeat = static_cast<int>(t.number(r, "repeat"));
+    row.load1 = t.number(r, "load1");
+    row.ms_refit = t.number(r, "ms_refit");
+    row.ms_traverse = t.number(r, "ms_traverse");
+    row.ms_narrow = t.number(r, "ms_narrow");
+  }
+  return rows;
+}
+
 namespace detail {
+
+std::string timing_rows_csv(const std::vector<TimingRow>& rows) {
+  std::string out =
+      "scene,step,build,culling,policy,threads,repeat,load1,ms_refit,ms_traverse,ms_narrow,"
+      "ms_total\n";
+  for (const auto& r : rows) {
+    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", r.scene, r.step, r.build, r.culling,
+                       r.policy, r.threads, r.repeat, num(r.load1), num(r.ms_refit),
+                       num(r.ms_traverse), num(r.ms_narrow), num(r.ms_total()));
+  }
+  return out;
+}
 
 std::string step_rows_csv(const std::vector<StepRow>& rows) {
   std::string out = "scene,step,build,culling,policy";

@@ -11,6 +11,7 @@
 namespace clothcd::experiment::detail {
 
 [[nodiscard]] std::string step_rows_csv(const std::vector<StepRow>& rows);
+[[nodiscard]] std::string timing_rows_csv(const std::vector<TimingRow>& rows);
 [[nodiscard]] std::string spread_rows_csv(const std::vector<SpreadRow>& rows);
 
 }  // namespace clothcd::experiment::detail

@@ -1,11 +1,16 @@
 // Tables of the experiment (markdown) and the merged CSVs, from the per-(scene, build) runs.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <unistd.h>
 #include <algorithm>
 #include <cmath>
+
 #include <cstdlib>
 #include <map>
 #include <numeric>
+#include <set>
+#include <tuple>
 
 #include "clothcd/core/atomic_file.hpp"
 #include "clothcd/experiment/experiment.hpp"
@@ -64,6 +69,15 @@ double median(std::vector<double> v) {
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const double pos = q * double(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(pos);
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - double(lo)) * (v[hi] - v[lo]);
+}
+
 struct Agg {
   int calls = 0;
   std::vector<double> pairs, vf, ee, culled, refit, cd, total;
@@ -95,6 +109,7 @@ struct SceneData {
   std::map<ConfigKey, Agg> agg;
   std::vector<StepRow> rows;
   std::vector<SpreadRow> spread;
+  std::vector<TimingRow> timing;
 };
 
 SceneData collect(const Sequence& seq, const ExperimentOptions& opt) {
@@ -118,6 +133,18 @@ SceneData collect(const Sequence& seq, const ExperimentOptions& opt) {
     if (fs::exists(sfile)) {
       for (auto& r : read_spread_rows(sfile)) {
         if (r.step < seq.steps()) d.spread.push_back(std::move(r));
+      }
+    }
+    const fs::path tfile = dir / (build_name(b) + ".timing.csv");
+    if (fs::exists(tfile)) {
+      for (auto& r : read_timing_rows(tfile)) {
+        if (r.step >= seq.steps()) continue;
+        if (r.culling != "none" &&
+            std::find(order.begin(), order.end(), ConfigKey{r.build, r.culling, r.policy}) ==
+                order.end()) {
+          continue;
+        }
+        d.timing.push_back(std::move(r));
       }
     }
   }
@@ -148,9 +175,33 @@ SceneData collect(const Sequence& seq, const ExperimentOptions& opt) {
   return d;
 }
 
-std::string scene_heading(const SceneData& d) {
-  return fmt::format("## {} ({} triangles, {} CD calls)\n\nFrames: {}\n\n", d.seq->name,
-                     grouped(double(d.seq->faces.size())), d.seq->steps(), d.seq->source);
+// "2nd", "3rd", "4th", "11th", "21st".
+std::string ordinal(int n) {
+  const int t = n % 100;
+  const char* suffix = (t >= 11 && t <= 13) ? "th"
+                       : n % 10 == 1        ? "st"
+                       : n % 10 == 2        ? "nd"
+                       : n % 10 == 3        ? "rd"
+                                            : "th";
+  return fmt::format("{}{}", n, suffix);
+}
+
+// CD calls run of a sequence (Sequence::every).
+int calls_run(const Sequence& seq, const ExperimentOptions& /*opt*/) {
+  const int e = std::max(1, seq.every);
+  return (seq.steps() + e - 1) / e;
+}
+
+std::string calls_text(const Sequence& seq, const ExperimentOptions& opt) {
+  const int run = calls_run(seq, opt);
+  return run == seq.steps()
+             ? fmt::format("{} CD calls", run)
+             : fmt::format("{} of its {} CD calls: every {}", run, seq.steps(), ordinal(seq.every));
+}
+
+std::string scene_heading(const SceneData& d, const ExperimentOptions& opt) {
+  return fmt::format("## {} ({} triangles, {})\n\nFrames: {}\n\n", d.seq->name,
+                     grouped(double(d.seq->faces.size())), calls_text(*d.seq, opt), d.seq->source);
 }
 
 std::string table1(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
@@ -204,7 +255,7 @@ std::string table1(const std::vector<SceneData>& data, const ExperimentOptions& 
   }
   s += "\n";
   for (const auto& d : data) {
-    s += scene_heading(d);
+    s += scene_heading(d, opt);
     s += "| build | culling | policy | calls | triangle pairs | vs PROVOT | vs none | VF tests | "
          "EE tests | nodes culled |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& k : config_order(opt)) {
@@ -236,7 +287,9 @@ std::string table2(const std::vector<SceneData>& data, const ExperimentOptions& 
       "CCD kernels), total = refit + CD; *vs PROVOT* = 1 - total / PROVOT's total under the "
       "same build and culling rule. Means as in the paper, plus the median of the total. All "
       "configurations of a step run back to back on the same frames, so machine noise is "
-      "shared; compare within a scene.\n\n"
+      "shared; compare within a scene. These are single calls (one per configuration and "
+      "step): indicative. The figures to quote are in timing.md (medians over repeated, "
+      "interleaved calls at 1 and 2 threads, with their spread and the load).\n\n"
       "### The paper (Han et al. 2021, Table 2; Intel Core i9-9900)\n\n"
       "| scene | BVH PROVOT | BVH PROPOSED | CD PROVOT | CD PROPOSED | total PROVOT | total "
       "PROPOSED | reduction |\n|---|---|---|---|---|---|---|---|\n";
@@ -251,7 +304,7 @@ std::string table2(const std::vector<SceneData>& data, const ExperimentOptions& 
   s += fmt::format("| average | | | | | | | {} (the paper states 18.24%) |\n\n",
                    pct(red_sum / std::size(kPaper)));
   for (const auto& d : data) {
-    s += scene_heading(d);
+    s += scene_heading(d, opt);
     s += "| build | culling | policy | calls | refit | CD | total | median total | vs PROVOT "
          "|\n|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& k : config_order(opt)) {
@@ -281,7 +334,7 @@ std::string misses(const std::vector<SceneData>& data, const ExperimentOptions& 
       "nothing.\n\n";
   int sound_fail = 0, extra_fail = 0;
   for (const auto& d : data) {
-    s += scene_heading(d);
+    s += scene_heading(d, opt);
     s += "| build | culling | policy | calls | reference VF | reference EE | missed VF | missed "
          "EE | calls with misses | extra | |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& k : config_order(opt)) {
@@ -323,7 +376,7 @@ std::string spread_table(const std::vector<SceneData>& data, const ExperimentOpt
       "the internal nodes whose OPTIMAL cone is not saturated, divided by OPTIMAL's mean there. "
       "*internal mean*: over all internal nodes, saturated cones counted as 90.\n\n";
   for (const auto& d : data) {
-    s += scene_heading(d);
+    s += scene_heading(d, opt);
     s += "| build | policy | node (depth) | node angle | internal mean | saturated share | "
          "mean on OPTIMAL domain | vs OPTIMAL | refit ms | steps |\n"
          "|---|---|---|---|---|---|---|---|---|---|\n";
@@ -371,6 +424,148 @@ std::string spread_table(const std::vector<SceneData>& data, const ExperimentOpt
   return s;
 }
 
+// Per (build, culling, policy, threads): the totals of the timing pass and, paired call by call
+// (same step, repeat and thread count), the ratio to PROVOT under the same rule.
+struct TimingAgg {
+  std::vector<double> total, refit, cd, ratio;
+  std::map<int, std::vector<double>> step_totals;  ///< the repeats of each timed step
+};
+using TimingKey = std::tuple<std::string, std::string, std::string, int>;
+
+std::map<TimingKey, TimingAgg> timing_aggs(const SceneData& d) {
+  std::map<std::tuple<std::string, std::string, int, int, int>, double> provot;
+  for (const auto& r : d.timing) {
+    if (r.policy == "PROVOT")
+      provot[{r.build, r.culling, r.step, r.repeat, r.threads}] = r.ms_total();
+  }
+  std::map<TimingKey, TimingAgg> out;
+  for (const auto& r : d.timing) {
+    TimingAgg& a = out[{r.build, r.culling, r.policy, r.threads}];
+    a.total.push_back(r.ms_total());
+    a.step_totals[r.step].push_back(r.ms_total());
+    a.refit.push_back(r.ms_refit);
+    a.cd.push_back(r.ms_traverse + r.ms_narrow);
+    const auto it = provot.find({r.build, r.culling, r.step, r.repeat, r.threads});
+    if (r.culling != "none" && it != provot.end() && it->second > 0) {
+      a.ratio.push_back(r.ms_total() / it->second);
+    }
+  }
+  return out;
+}
+
+// A figure is flagged noisy when the same call, repeated, varies by more than a fifth of its
+// median (the steps differ in cost by themselves, so the spread over all calls would not say).
+constexpr double kNoisy = 0.2;
+
+// Median over the timed steps of (max - min) / median of that step's repeats.
+double repeat_spread(const TimingAgg& a) {
+  std::vector<double> v;
+  for (const auto& [step, t] : a.step_totals) {
+    const double m = median(t);
+    if (t.size() >= 2 && m > 0)
+      v.push_back((*std::max_element(t.begin(), t.end()) - *std::min_element(t.begin(), t.end())) /
+                  m);
+  }
+  return median(v);
+}
+
+bool noisy(const std::vector<double>& v) {
+  const double m = median(v);
+  return !(m > 0) || (quantile(v, 0.75) - quantile(v, 0.25)) > kNoisy * m;
+}
+
+std::string timing_table(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
+  std::string s = fmt::format(
+      "# Timings per CD call (ms): medians over repeated, interleaved calls\n\n"
+      "The timing pass runs on {} that the experiment runs: each configuration "
+      "(the unculled reference and every policy under the timed rules) {} times under each thread "
+      "count, repeat by repeat, thread count by thread count, with the configurations in an "
+      "order rotated per repeat, all on the same frame pair. *total* = refit + traversal + "
+      "narrow phase; p25-p75 = interquartile range over those calls (the steps differ in cost by "
+      "themselves); *repeat spread* = the median over the timed steps of (max - min) / median of "
+      "one step's repeats, the noise of the machine; */ PROVOT* = median of "
+      "the ratio to PROVOT's total of the same call (same step, repeat and thread count, same "
+      "build and rule): below 1 = faster. A row is marked *noisy* when its repeat spread "
+      "exceeds {:.0f}%. *load* = the 1-minute load average read before "
+      "each timed step (min-max); on a machine with as many cores as threads in use, anything "
+      "above the thread count means other processes shared the cores.\n\n",
+      opt.timing_every == 1 ? std::string("every CD call")
+                            : fmt::format("every {} CD call", ordinal(opt.timing_every)),
+      opt.timing_repeats, 100 * kNoisy);
+  bool any = false;
+  for (const auto& d : data) {
+    if (d.timing.empty()) continue;
+    any = true;
+    std::set<int> steps;
+    double lo = 1e300, hi = -1e300;
+    for (const auto& r : d.timing) {
+      steps.insert(r.step);
+      lo = std::min(lo, r.load1);
+      hi = std::max(hi, r.load1);
+    }
+    s += scene_heading(d, opt);
+    s += fmt::format(
+        "Timed steps: {} ({}); load {:.2f}-{:.2f}.\n\n", steps.size(),
+        steps.size() <= 12 ? fmt::format("{}", fmt::join(steps, ", ")) : "see timing.csv", lo, hi);
+    if (const long cores = ::sysconf(_SC_NPROCESSORS_ONLN); cores > 0 && hi > double(cores)) {
+      s += fmt::format(
+          "**Shared machine: the load reached {:.2f} on {} cores while this scene was timed, so "
+          "other processes took turns on the cores; every time below is noisy, the ratios to "
+          "PROVOT (paired call by call) less so.**\n\n",
+          hi, cores);
+    }
+    s += "| build | culling | policy | threads | calls | median total | p25-p75 | repeat spread | "
+         "median refit | median CD | / PROVOT | "
+         "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    const auto agg = timing_aggs(d);
+    for (const auto& k : config_order(opt)) {
+      for (int t = 1; t <= 1024; ++t) {
+        const auto it = agg.find({k.build, k.culling, k.policy, t});
+        if (it == agg.end()) continue;
+        const TimingAgg& a = it->second;
+        const double spread = repeat_spread(a);
+        const bool n = !(spread <= kNoisy);
+        s += fmt::format(
+            "| {} | {} | {} | {} | {} | {:.2f} | {:.2f}-{:.2f} | {} | {:.2f} | {:.2f} | {} | {} "
+            "|\n",
+            k.build, k.culling, k.policy, t, a.total.size(), median(a.total),
+            quantile(a.total, 0.25), quantile(a.total, 0.75),
+            std::isnan(spread) ? std::string("-") : fmt::format("{:.0f}%", 100 * spread),
+            median(a.refit), median(a.cd),
+            a.ratio.empty() ? std::string("-") : fmt::format("{:.3f}", median(a.ratio)),
+            n ? "noisy" : "");
+      }
+    }
+    s += "\n";
+  }
+  if (!any) s += "No timing pass was run (`--timing-every`).\n";
+  return s;
+}
+
+// Self-crossing pairs of the frames, per scene.
+std::string sequences_table(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
+  std::string s =
+      "| scene | triangles | frames | CD calls | CD calls run | crossing pairs in the frames "
+      "(sum, max per frame) | counted by |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& d : data) {
+    const auto& c = d.seq->crossings;
+    std::string crossing = "not counted";
+    if (!c.empty()) {
+      long long sum = 0, mx = 0;
+      for (long long v : c) {
+        sum += v;
+        mx = std::max(mx, v);
+      }
+      crossing = fmt::format("{}, {}", grouped(double(sum)), grouped(double(mx)));
+    }
+    s += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", d.seq->name,
+                     grouped(double(d.seq->faces.size())), d.seq->frames.size(), d.seq->steps(),
+                     calls_run(*d.seq, opt), crossing,
+                     d.seq->crossings_how.empty() ? "-" : d.seq->crossings_how);
+  }
+  return s + "\n";
+}
+
 }  // namespace
 
 // The closing-note view: per scene, build and rule, PROPOSED's and EXACT's reductions vs PROVOT
@@ -381,19 +576,31 @@ std::string summary(const std::vector<SceneData>& data, const ExperimentOptions&
       "Per scene, BVH build and culling rule: the reduction in triangle pair tests and in mean "
       "total time per CD call (1 - X / PROVOT, positive = fewer / faster; from table1.md and "
       "table2.md), and the collisions each policy missed against the unculled reference, summed "
-      "over the calls (from misses.md). Spread angles relative to OPTIMAL: spread.md.\n\n"
+      "over the calls (from misses.md). *time* is the single timed call per configuration and "
+      "step of the counting pass (indicative); *timed 1 / 2 thr* is 1 - the median ratio to "
+      "PROVOT of the timing pass (timing.md, repeated interleaved calls, 1 and 2 threads; "
+      "`*` = noisy there). Spread angles relative to OPTIMAL: spread.md.\n\n"
+      "## The sequences\n\n" +
+      sequences_table(data, opt) +
+      "## PROPOSED and EXACT against PROVOT\n\n"
       "| scene | calls | build | rule | pairs PROPOSED | pairs EXACT | time PROPOSED | time EXACT "
-      "| missed PROVOT / PROPOSED / EXACT (of reference) "
-      "|\n|---|---|---|---|---|---|---|---|---|\n";
+      "| timed PROPOSED 1 / 2 thr | missed PROVOT / PROPOSED / EXACT (of reference) "
+      "|\n|---|---|---|---|---|---|---|---|---|---|\n";
   auto find = [](const SceneData& d, const ConfigKey& k) -> const Agg* {
     const auto it = d.agg.find(k);
     return it == d.agg.end() ? nullptr : &it->second;
   };
   for (const auto& d : data) {
+    const auto tagg = timing_aggs(d);
     for (BvhBuild b : opt.builds) {
       for (Culling c : opt.cullings) {
         if (c == Culling::None) continue;
         const std::string bn = build_name(b), cn = culling_name(c);
+        auto timed = [&](int t) -> std::string {
+          const auto it = tagg.find({bn, cn, "PROPOSED", t});
+          if (it == tagg.end() || it->second.ratio.empty()) return "-";
+          return pct(1.0 - median(it->second.ratio)) + (noisy(it->second.ratio) ? "*" : "");
+        };
         const Agg* base = find(d, {bn, cn, "PROVOT"});
         if (base == nullptr) continue;
         auto red = [&](const char* policy, auto&& field) -> std::string {
@@ -406,11 +613,11 @@ std::string summary(const std::vector<SceneData>& data, const ExperimentOptions&
           const Agg* a = find(d, {bn, cn, policy});
           return a != nullptr ? grouped(a->missed_vf + a->missed_ee) : "-";
         };
-        s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} / {} (of {}) |\n",
-                         d.seq->name, base->calls, bn, cn, red("PROPOSED", pairs),
-                         red("EXACT", pairs), red("PROPOSED", total), red("EXACT", total),
-                         missed("PROVOT"), missed("PROPOSED"), missed("EXACT"),
-                         grouped(base->ref_vf + base->ref_ee));
+        s += fmt::format(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} / {} / {} (of {}) |\n",
+            d.seq->name, base->calls, bn, cn, red("PROPOSED", pairs), red("EXACT", pairs),
+            red("PROPOSED", total), red("EXACT", total), timed(1), timed(2), missed("PROVOT"),
+            missed("PROPOSED"), missed("EXACT"), grouped(base->ref_vf + base->ref_ee));
       }
     }
   }
@@ -428,13 +635,30 @@ void write_reports(const std::vector<Sequence>& scenes, const ExperimentOptions&
     rows.insert(rows.end(), d.rows.begin(), d.rows.end());
     spread.insert(spread.end(), d.spread.begin(), d.spread.end());
   }
+  std::vector<TimingRow> timing;
+  for (const auto& d : data)
+    timing.insert(timing.end(), d.timing.begin(), d.timing.end());
   write_file_atomic(opt.out / "steps.csv", detail::step_rows_csv(rows));
   write_file_atomic(opt.out / "spread.csv", detail::spread_rows_csv(spread));
-  write_file_atomic(opt.out / "table1.md", table1(data, opt));
-  write_file_atomic(opt.out / "table2.md", table2(data, opt));
-  write_file_atomic(opt.out / "misses.md", misses(data, opt));
-  write_file_atomic(opt.out / "spread.md", spread_table(data, opt));
-  write_file_atomic(opt.out / "summary.md", summary(data, opt));
+  write_file_atomic(opt.out / "timing.csv", detail::timing_rows_csv(timing));
+  // The provenance goes right under each report's title line.
+  const std::string stamp_lines =
+      opt.stamp.empty()
+          ? std::string()
+          : opt.stamp + fmt::format("- written: load average (1, 5, 15 min) {}\n", load_average());
+  auto stamped = [&](std::string text) {
+    if (stamp_lines.empty()) return text;
+    const auto eol = text.find("\n\n");
+    return eol == std::string::npos
+               ? stamp_lines + text
+               : text.substr(0, eol + 2) + stamp_lines + "\n" + text.substr(eol + 2);
+  };
+  write_file_atomic(opt.out / "table1.md", stamped(table1(data, opt)));
+  write_file_atomic(opt.out / "table2.md", stamped(table2(data, opt)));
+  write_file_atomic(opt.out / "timing.md", stamped(timing_table(data, opt)));
+  write_file_atomic(opt.out / "misses.md", stamped(misses(data, opt)));
+  write_file_atomic(opt.out / "spread.md", stamped(spread_table(data, opt)));
+  write_file_atomic(opt.out / "summary.md", stamped(summary(data, opt)));
 }
 
 std::string run_plots(const fs::path& out, const fs::path& script, const std::string& python) {

@@ -2,10 +2,12 @@
 // construction; policy and culling change per call), the unculled reference first at every step,
 // then each (policy, culling), all on the same two frames, so timing noise is shared step by step.
 #include <fmt/format.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <numbers>
 #include <optional>
 #include <set>
@@ -162,6 +164,65 @@ std::vector<SpreadRow> spreads(const Sequence& seq, BvhBuild build, int step, Bv
   return out;
 }
 
+double load1() {
+  std::ifstream in("/proc/loadavg");
+  double v = std::nan("");
+  in >> v;
+  return v;
+}
+
+TimingRow timing_row(const Sequence& seq, BvhBuild build, int step, Culling c, ConePolicy p,
+                     int threads, int repeat, double load, const DetectStats& s) {
+  TimingRow row;
+  row.scene = seq.name;
+  row.build = build_name(build);
+  row.culling = culling_name(c);
+  row.policy = c == Culling::None ? "-" : policy_name(p);
+  row.step = step;
+  row.threads = threads;
+  row.repeat = repeat;
+  row.load1 = load;
+  row.ms_refit = 1e3 * s.time_refit;
+  row.ms_traverse = 1e3 * s.time_traverse;
+  row.ms_narrow = 1e3 * s.time_narrow;
+  return row;
+}
+
+// The timing pass of one step (see ExperimentOptions::timing_every).
+std::vector<TimingRow> time_step(const Sequence& seq, BvhBuild build, int step,
+                                 const ExperimentOptions& opt, SelfDetector& det,
+                                 const Positions& x0, const Positions& x1) {
+  std::vector<std::pair<ConePolicy, Culling>> cfgs{{ConePolicy::Provot, Culling::None}};
+  for (Culling c : opt.timing_cullings) {
+    if (c == Culling::None) continue;
+    for (ConePolicy p : opt.policies)
+      cfgs.emplace_back(p, c);
+  }
+  const double load = load1();
+  std::vector<TimingRow> out;
+  const std::size_t n = cfgs.size();
+  for (int rep = 0; rep < opt.timing_repeats; ++rep) {
+    for (int t : opt.timing_threads) {
+      const tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                                      static_cast<std::size_t>(std::max(1, t)));
+      const int threads = static_cast<int>(
+          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+      for (std::size_t i = 0; i < n; ++i) {
+        // Rotated per repeat: no configuration always runs first (cold caches) or last.
+        const auto [p, c] = cfgs[(i + static_cast<std::size_t>(rep)) % n];
+        DetectOptions o;
+        o.build = build;
+        o.policy = p;
+        o.culling = c;
+        det.set_options(o);
+        const DetectResult r = det.detect(x0, x1);
+        out.push_back(timing_row(seq, build, step, c, p, threads, rep, load, r.stats));
+      }
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
@@ -177,10 +238,18 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
   const fs::path dir = opt.out / "runs" / seq.name;
   fs::create_directories(dir);
   int done = done_before;
-  if (total <= 0) total = seq.steps() * static_cast<int>(opt.builds.size());
+  const int every = std::max(1, seq.every);
+  const int run_steps = (seq.steps() + every - 1) / every;
+  if (total <= 0) total = run_steps * static_cast<int>(opt.builds.size());
   for (BvhBuild build : opt.builds) {
     const fs::path file = dir / (build_name(build) + ".csv");
     const fs::path sfile = dir / (build_name(build) + ".spread.csv");
+    const fs::path tfile = dir / (build_name(build) + ".timing.csv");
+    std::vector<TimingRow> trows =
+        fs::exists(tfile) ? read_timing_rows(tfile) : std::vector<TimingRow>{};
+    std::set<int> have_timing;
+    for (const auto& r : trows)
+      have_timing.insert(r.step);
     std::vector<StepRow> rows = fs::exists(file) ? read_step_rows(file) : std::vector<StepRow>{};
     std::vector<SpreadRow> srows =
         fs::exists(sfile) ? read_spread_rows(sfile) : std::vector<SpreadRow>{};
@@ -216,7 +285,7 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
       }
     };
 
-    for (int step = 0; step < seq.steps(); ++step) {
+    for (int step = 0; step < seq.steps(); step += every) {
       std::vector<std::pair<ConePolicy, Culling>> todo;
       for (ConePolicy p : opt.policies) {
         for (Culling c : opt.cullings) {
@@ -225,15 +294,18 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
         }
       }
       const bool need_none = !have.contains({step, "none", "-"});
-      const bool optimal_step = opt.optimal_every > 0 && step % opt.optimal_every == 0 &&
+      const bool optimal_step = opt.optimal_every > 0 && (step / every) % opt.optimal_every == 0 &&
                                 (opt.optimal_max_faces <= 0 ||
                                  static_cast<int>(seq.faces.size()) <= opt.optimal_max_faces);
       bool need_spread = optimal_step && !have_spread.contains({step, "OPTIMAL"});
       for (ConePolicy p : opt.policies)
         need_spread = need_spread || !have_spread.contains({step, policy_name(p)});
+      const bool need_timing =
+          opt.timing_every > 0 && opt.timing_repeats > 0 && !opt.timing_threads.empty() &&
+          (step / every) % opt.timing_every == 0 && !have_timing.contains(step);
       const std::string what =
           fmt::format("{} {} step {}/{}", seq.name, build_name(build), step + 1, seq.steps());
-      if (todo.empty() && !need_none && !need_spread) {
+      if (todo.empty() && !need_none && !need_spread && !need_timing) {
         ++done;
         if (on_progress) on_progress({done, total, false, what});
         continue;
@@ -267,6 +339,12 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
           have_spread.emplace(step, r.policy);
           srows.push_back(std::move(r));
         }
+      }
+      if (need_timing) {
+        for (auto& r : time_step(seq, build, step, opt, *det, x0, x1))
+          trows.push_back(std::move(r));
+        have_timing.insert(step);
+        write_file_atomic(tfile, detail::timing_rows_csv(trows));
       }
       std::stable_sort(rows.begin(), rows.end(),
                        [](const StepRow& a, const StepRow& b) { return a.step < b.step; });

@@ -14,6 +14,7 @@
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/sim/frame_io.hpp"
+#include "clothcd/sim/intersections.hpp"
 #include "clothcd/sim/scene.hpp"
 #include "clothcd/sim/simulation.hpp"
 
@@ -48,7 +49,8 @@ std::string sanitize(std::string s) {
   return s.empty() ? std::string("scene") : s;
 }
 
-std::vector<fs::path> frame_files(const fs::path& dir, int max_frames) {
+std::vector<fs::path> frame_files(const fs::path& dir, int max_frames,
+                                  std::vector<long long>* crossings) {
   std::vector<fs::path> files;
   const fs::path manifest = dir / "manifest.json";
   if (fs::exists(manifest)) {
@@ -61,6 +63,17 @@ std::vector<fs::path> frame_files(const fs::path& dir, int max_frames) {
       const std::string ext = m.at("mesh_format").get<std::string>();
       for (int k = 0; k <= complete; ++k)
         files.push_back(dir / fmt::format("frame_{:04d}.{}", k, ext));
+      // The simulator's own count of each frame's self-crossing pairs (seam-linked pairs
+      // skipped); left empty when a frame lacks it, so the caller counts instead.
+      std::vector<long long> c(files.size(), -1);
+      if (m.contains("initial_self_intersections"))
+        c[0] = m["initial_self_intersections"].get<long long>();
+      for (const auto& f : m.value("frames", nlohmann::json::array())) {
+        const int k = f.value("frame", -1);
+        if (k >= 0 && k < static_cast<int>(c.size()) && f.contains("self_intersections"))
+          c[static_cast<std::size_t>(k)] = f["self_intersections"].get<long long>();
+      }
+      if (std::find(c.begin(), c.end(), -1) == c.end()) *crossings = std::move(c);
     } catch (const nlohmann::json::exception& e) {
       throw input_error(manifest.string(), 0, fmt::format("unreadable manifest: {}", e.what()));
     }
@@ -74,6 +87,7 @@ std::vector<fs::path> frame_files(const fs::path& dir, int max_frames) {
     });
   }
   if (max_frames >= 0 && static_cast<int>(files.size()) > max_frames) files.resize(max_frames);
+  if (crossings->size() > files.size()) crossings->resize(files.size());
   return files;
 }
 
@@ -98,7 +112,8 @@ Sequence one_step(const ProceduralScene& s) {
 
 Sequence load_frame_folder(const fs::path& dir, int max_frames, std::string name) {
   if (!fs::is_directory(dir)) throw input_error(dir.string(), 0, "not a folder of frames");
-  const auto files = frame_files(dir, max_frames);
+  std::vector<long long> crossings;
+  const auto files = frame_files(dir, max_frames, &crossings);
   if (files.size() < 2) {
     throw input_error(dir.string(), 0,
                       "expected at least two frames (manifest.json + frame_NNNN.obj|ply, or "
@@ -123,7 +138,36 @@ Sequence load_frame_folder(const fs::path& dir, int max_frames, std::string name
     validate_mesh(m, files[k].string());
     seq.frames.push_back(to_positions(m.vertices));
   }
+  if (!crossings.empty()) {
+    seq.crossings = std::move(crossings);
+    seq.crossings_how = "the simulator's check (manifest.json; stitched pairs skipped)";
+  }
   return seq;
+}
+
+void count_crossings(Sequence& seq) {
+  if (seq.crossings.size() == seq.frames.size()) return;
+  Topology topo(seq.faces, seq.num_vertices);
+  sim::IntersectionCounter counter(topo, {}, {}, 0);
+  seq.crossings.clear();
+  std::vector<sim::Vec3> x;
+  for (const Positions& p : seq.frames) {
+    x.resize(static_cast<std::size_t>(p.rows()));
+    for (Eigen::Index i = 0; i < p.rows(); ++i)
+      x[static_cast<std::size_t>(i)] = p.row(i).transpose();
+    seq.crossings.push_back(static_cast<long long>(counter.self_pairs(x).size()));
+  }
+  seq.crossings_how = "clothcd's intersection check (sim/intersections.hpp)";
+}
+
+void drop_frames_before(Sequence& seq, int first) {
+  if (first <= 0) return;
+  const auto n = std::min<std::size_t>(static_cast<std::size_t>(first), seq.frames.size());
+  seq.frames.erase(seq.frames.begin(), seq.frames.begin() + static_cast<std::ptrdiff_t>(n));
+  if (seq.crossings.size() >= n) {
+    seq.crossings.erase(seq.crossings.begin(),
+                        seq.crossings.begin() + static_cast<std::ptrdiff_t>(n));
+  }
 }
 
 Sequence simulate_scene(const fs::path& scene_file, const fs::path& out, int frames,

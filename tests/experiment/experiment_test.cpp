@@ -160,7 +160,8 @@ TEST(Experiment, RowsPerStepAndConfigurationSoundEqualsReference) {
   EXPECT_GE(check_markdown_tables(slurp(opt.out / "spread.md")), 8);
   // Summary: one row per build and culling rule, with PROVOT's misses equal to misses.md's.
   const std::string su = slurp(opt.out / "summary.md");
-  EXPECT_EQ(check_markdown_tables(su), 7);  // separator + 2 builds x 3 rules
+  // The sequences table (separator + 1 scene), then separator + 2 builds x 3 rules.
+  EXPECT_EQ(check_markdown_tables(su), 2 + 7);
   EXPECT_NE(su.find("| spatial | sound | "), std::string::npos);
   EXPECT_NE(t1.find("| spatial | gated | EXACT | 4 |"), std::string::npos);
   EXPECT_NE(t2.find("| patch | sound | PROVOT | 4 |"), std::string::npos);

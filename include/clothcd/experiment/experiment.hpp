@@ -31,11 +31,31 @@ struct ExperimentOptions {
   std::vector<ConePolicy> policies{ConePolicy::Provot, ConePolicy::Proposed, ConePolicy::Exact};
   std::vector<Culling> cullings{Culling::Cone, Culling::Gated, Culling::Sound};
   std::vector<BvhBuild> builds{BvhBuild::Spatial, BvhBuild::Patch};
-  /// OPTIMAL cones are computed on steps 0, K, 2K, ... (0: never).
+  /// OPTIMAL cones are computed on the run calls 0, K, 2K, ... (see Sequence::every; 0: never).
   int optimal_every = 10;
   /// No OPTIMAL cones for sequences with more triangles than this (0: no limit): its refit has
   /// no saturation shortcut and takes minutes on large, crumpled garments.
   int optimal_max_faces = 0;
+  /// Timing pass, on the run calls 0, T, 2T, ... (of those Sequence::every selects) (0: none):
+  /// every configuration (the unculled reference, `timing_cullings` x policies) `timing_repeats`
+  /// times under each thread count of `timing_threads`, interleaved (repeat-major, then threads,
+  /// then configurations in an order rotated per repeat), so load drifts hit all of them alike.
+  /// Thread counts are capped by any tbb::global_control the caller holds.
+  int timing_every = 0;
+  int timing_repeats = 3;
+  std::vector<int> timing_threads{1, 2};
+  std::vector<Culling> timing_cullings{Culling::Cone, Culling::Gated, Culling::Sound};
+  /// Lines written at the top of every report (commit, machine, date, load, ...); see stamp().
+  std::string stamp;
+};
+
+/// One timed CD call of the timing pass (see ExperimentOptions::timing_every). `load1` is the
+/// 1-minute load average read before the step's timing started.
+struct TimingRow {
+  std::string scene, build, culling, policy;
+  int step = 0, threads = 1, repeat = 0;
+  double load1 = 0, ms_refit = 0, ms_traverse = 0, ms_narrow = 0;
+  [[nodiscard]] double ms_total() const { return ms_refit + ms_traverse + ms_narrow; }
 };
 
 /// One CD call of one configuration. `policy` is "-" for the unculled reference (culling none).
@@ -80,7 +100,8 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& options,
                   int total = 0);
 
 /// Reads the runs of the given scenes from OUT/runs/ and writes OUT/steps.csv, OUT/spread.csv,
-/// OUT/table1.md, OUT/table2.md and OUT/misses.md (all atomically).
+/// OUT/timing.csv, OUT/table1.md, OUT/table2.md, OUT/timing.md, OUT/misses.md, OUT/spread.md and
+/// OUT/summary.md (all atomically). Calls count_crossings-style counts from `scenes` when present.
 void write_reports(const std::vector<Sequence>& scenes, const ExperimentOptions& options);
 
 /// Runs the plot script (fig5.png, fig6.png in OUT) with `python`. Returns an empty string on
@@ -88,6 +109,16 @@ void write_reports(const std::vector<Sequence>& scenes, const ExperimentOptions&
 [[nodiscard]] std::string run_plots(const std::filesystem::path& out,
                                     const std::filesystem::path& script,
                                     const std::string& python = "/usr/bin/python3");
+
+[[nodiscard]] std::vector<TimingRow> read_timing_rows(const std::filesystem::path& csv);
+
+/// The provenance lines of a report: the command, the commit of `source_dir` (git, "unknown"
+/// without it), the machine (cores, CPU model), the worker threads, the UTC date and the load
+/// average now (the "before" of a run; write_reports adds the load when it writes).
+[[nodiscard]] std::string stamp(const std::string& command, const std::filesystem::path& source_dir,
+                                const std::string& threads);
+/// The 1, 5 and 15 minute load averages ("unknown" where /proc/loadavg is missing).
+[[nodiscard]] std::string load_average();
 
 [[nodiscard]] std::vector<StepRow> read_step_rows(const std::filesystem::path& csv);
 [[nodiscard]] std::vector<SpreadRow> read_spread_rows(const std::filesystem::path& csv);

@@ -18,6 +18,12 @@ struct Sequence {
   std::vector<Face> faces;
   int num_vertices = 0;
   std::vector<Positions> frames;  ///< n x 3 each; frames.size() - 1 steps
+  /// Self-crossing triangle pairs per frame (same length as `frames` once counted, see
+  /// count_crossings), and how they were counted. Empty: not counted.
+  std::vector<long long> crossings;
+  std::string crossings_how;
+  /// The experiment runs the CD calls 0, every, 2 every, ... (each one frame pair k -> k+1).
+  int every = 1;
 
   [[nodiscard]] int steps() const { return frames.empty() ? 0 : int(frames.size()) - 1; }
 };
@@ -34,6 +40,15 @@ struct Sequence {
 [[nodiscard]] Sequence simulate_scene(const std::filesystem::path& scene_file,
                                       const std::filesystem::path& out, int frames,
                                       const std::function<void(int, int)>& on_frame = {});
+
+/// Fills `crossings` if it is empty: intersecting non-adjacent triangle pairs of every frame, by
+/// the simulator's intersection check (clothcd/sim/intersections.hpp, no seam links). Simulated
+/// folders come with the simulator's own per-frame counts (which skip stitched pairs), read by
+/// load_frame_folder.
+void count_crossings(Sequence& seq);
+
+/// Drops the frames before `first` (and their crossing counts); the sequence keeps its name.
+void drop_frames_before(Sequence& seq, int first);
 
 /// A procedural sequence: an n x n sheet (2 n^2 triangles) with a ripple; its far half folds
 /// about the middle line onto the near half (0 to 180 degrees over the first half of the steps),
