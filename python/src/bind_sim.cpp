@@ -3,6 +3,8 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <string>
+
 #include "arrays.hpp"
 #include "bindings.hpp"
 #include "clothcd/sim/frame_io.hpp"
@@ -12,8 +14,8 @@
 namespace clothcd::python {
 namespace {
 
-py::object to_python(const nlohmann::json& j) {
-  return py::module_::import("json").attr("loads")(j.dump());
+py::object to_python(const std::string& json_text) {
+  return py::module_::import("json").attr("loads")(json_text);
 }
 
 }  // namespace
@@ -34,7 +36,7 @@ void bind_sim(py::module_& m) {
         if (!progress.is_none()) {
           opt.on_frame = [&progress](const sim::FrameStats& s, int total) {
             py::gil_scoped_acquire gil;
-            progress(to_python(sim::to_json(s)), total);
+            progress(to_python(sim::frame_stats_json(s)), total);
           };
         }
         Workers workers(threads);
@@ -44,7 +46,7 @@ void bind_sim(py::module_& m) {
         });
         py::list out_stats;
         for (const auto& s : done)
-          out_stats.append(to_python(sim::to_json(s)));
+          out_stats.append(to_python(sim::frame_stats_json(s)));
         return out_stats;
       },
       py::arg("scene_path"), py::arg("out"), py::arg("frames") = py::none(),

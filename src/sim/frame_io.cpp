@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <sys/file.h>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <bit>
 #include <cerrno>
@@ -233,6 +234,8 @@ ClothState read_state(const std::filesystem::path& path, int num_vertices, int& 
   return s;
 }
 
+namespace {
+
 nlohmann::json to_json(const FrameStats& s) {
   return {{"frame", s.frame},
           {"time", s.time},
@@ -274,6 +277,12 @@ nlohmann::json to_json(const FrameStats& s) {
             {"reused_pairs", s.self_proximity.reused_pairs},
             {"pairs", s.self_proximity.pairs},
             {"query_s", s.self_proximity.query_s}}}};
+}
+
+}  // namespace
+
+std::string frame_stats_json(const FrameStats& s) {
+  return to_json(s).dump();
 }
 
 std::vector<FrameStats> run_simulation(Simulation& sim, const RunOptions& opt) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <set>
 
@@ -14,6 +15,7 @@
 #include "clothcd/detect/names.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/sim/sewing.hpp"
+#include "sim/scene_json.hpp"
 
 namespace clothcd::sim {
 namespace {
@@ -276,11 +278,16 @@ std::filesystem::path data_root_for(const std::filesystem::path& scene_file) {
 }
 
 Scene load_scene(const std::filesystem::path& file) {
-  std::ifstream in(file);
+  std::ifstream in(file, std::ios::binary);
   if (!in) throw input_error(file.string(), 0, "cannot open scene file");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parse_scene_text(text, file);
+}
+
+Scene parse_scene_text(std::string_view json_text, const std::filesystem::path& file) {
   json j;
   try {
-    j = json::parse(in);
+    j = json::parse(json_text);
   } catch (const json::exception& e) {
     // Not only parse_error: a number beyond double's range is an out_of_range (found by
     // fuzz_scene).

@@ -8,6 +8,7 @@
 
 #include "clothcd/sim/simulation.hpp"
 #include "hash.hpp"
+#include "sim/scene_json.hpp"
 
 namespace clothcd::sim {
 namespace {

@@ -1,5 +1,6 @@
 // Atomic output, state round trip, and resume that matches a straight run bitwise.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 #include "clothcd/core/error.hpp"
 #include "clothcd/sim/frame_io.hpp"
 #include "hash.hpp"
+#include "sim/scene_json.hpp"
 
 namespace clothcd::sim {
 namespace {

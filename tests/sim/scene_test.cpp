@@ -1,5 +1,6 @@
 // Scene JSON validation, procedural scenes, the substep rule and OBJ reading.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include "clothcd/sim/scene.hpp"
 #include "clothcd/sim/sewing.hpp"
 #include "clothcd/sim/simulation.hpp"
+#include "sim/scene_json.hpp"
 #include "support/data.hpp"
 
 namespace clothcd::sim {
@@ -34,6 +36,23 @@ std::string error_of(const json& j) {
     return e.what();
   }
   return "";
+}
+
+TEST(Scene, TextEqualsParsedJson) {
+  const Scene a = parse_scene(small_grid_scene(), "test-scene.json");
+  const Scene b = parse_scene_text(small_grid_scene().dump(), "test-scene.json");
+  EXPECT_EQ(a.cloth.positions, b.cloth.positions);
+  EXPECT_EQ(a.cloth.faces, b.cloth.faces);
+  EXPECT_EQ(a.frames, b.frames);
+  ASSERT_EQ(a.pins.size(), b.pins.size());
+  try {
+    (void)parse_scene_text("{\"frames\": 2,", "broken.json");
+    ADD_FAILURE() << "a truncated document parsed";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("broken.json"), std::string::npos) << m;
+    EXPECT_NE(m.find("invalid JSON"), std::string::npos) << m;
+  }
 }
 
 TEST(Scene, SmallGridParses) {

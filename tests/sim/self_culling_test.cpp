@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "clothcd/sim/simulation.hpp"
+#include "sim/scene_json.hpp"
 
 namespace clothcd::sim {
 namespace {

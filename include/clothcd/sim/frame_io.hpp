@@ -7,7 +7,6 @@
 
 #include <filesystem>
 #include <functional>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -50,7 +49,8 @@ void write_state_atomic(const std::filesystem::path& path, const ClothState& sta
 [[nodiscard]] ClothState read_state(const std::filesystem::path& path, int num_vertices,
                                     int& frame);
 
-[[nodiscard]] nlohmann::json to_json(const FrameStats& s);
+/// One frame's statistics as a JSON object (text), as manifest.json lists them under "frames".
+[[nodiscard]] std::string frame_stats_json(const FrameStats& s);
 
 /// Runs a simulation into a folder: frame_NNNN.{obj,ply}, state_NNNN.bin (the last frame's, and
 /// every `keep_states`-th), manifest.json. With `resume`, continues from the manifest's last

@@ -8,9 +8,9 @@
 
 #include <filesystem>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "clothcd/sim/body.hpp"
 #include "clothcd/sim/cloth_model.hpp"
@@ -64,8 +64,9 @@ struct Scene {
 /// Reads and validates a scene. Throws clothcd::InputError naming the scene file and the key
 /// (unknown keys, wrong types, missing files, bad values).
 [[nodiscard]] Scene load_scene(const std::filesystem::path& file);
-/// The same from parsed JSON; `file` names the scene in messages and anchors relative paths.
-[[nodiscard]] Scene parse_scene(const nlohmann::json& j, const std::filesystem::path& file);
+/// The same from the text of a scene file; `file` names the scene in messages and anchors
+/// relative paths (it need not exist).
+[[nodiscard]] Scene parse_scene_text(std::string_view json_text, const std::filesystem::path& file);
 
 /// The `${CLOTHCD_DATA}` value for a scene file.
 [[nodiscard]] std::filesystem::path data_root_for(const std::filesystem::path& scene_file);
