@@ -12,9 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -25,6 +23,7 @@
 
 #include "clothcd/core/atomic_file.hpp"
 #include "clothcd/core/error.hpp"
+#include "clothcd/experiment/experiment.hpp"
 #include "clothcd/sim/simulation.hpp"
 
 namespace clothcd::app {
@@ -61,60 +60,11 @@ struct SceneResult {
   std::vector<std::string> csv_rows;
 };
 
-std::string shell_line(const std::string& cmd) {
-  std::string out;
-  if (FILE* p = ::popen(cmd.c_str(), "r")) {
-    char buf[256];
-    while (std::fgets(buf, sizeof buf, p) != nullptr)
-      out += buf;
-    ::pclose(p);
-  }
-  while (!out.empty() && (out.back() == '\n' || out.back() == '\r'))
-    out.pop_back();
-  return out;
-}
-
 fs::path source_dir() {
 #ifdef CLOTHCD_SOURCE_DIR
   if (fs::exists(fs::path(CLOTHCD_SOURCE_DIR) / ".git")) return CLOTHCD_SOURCE_DIR;
 #endif
   return fs::current_path();
-}
-
-std::string commit() {
-  const std::string dir = source_dir().string();
-  const std::string head = shell_line(fmt::format("git -C '{}' rev-parse HEAD 2>/dev/null", dir));
-  if (head.empty()) return "unknown";
-  const std::string dirty = shell_line(
-      fmt::format("git -C '{}' status --porcelain --untracked-files=no 2>/dev/null", dir));
-  return dirty.empty() ? head : head + " (with uncommitted changes)";
-}
-
-std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  for (std::string line; std::getline(in, line);) {
-    if (line.starts_with("model name")) {
-      const auto colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
-    }
-  }
-  return "unknown";
-}
-
-std::string load_average() {
-  std::ifstream in("/proc/loadavg");
-  std::string a, b, c;
-  if (!(in >> a >> b >> c)) return "unknown";
-  return fmt::format("{} {} {}", a, b, c);
-}
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  ::gmtime_r(&t, &tm);
-  char buf[64];
-  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
-  return buf;
 }
 
 double median(std::vector<double> v) {
@@ -305,8 +255,8 @@ int run_in_situ(const InSituArgs& a) {
     limit.emplace(tbb::global_control::max_allowed_parallelism,
                   static_cast<std::size_t>(a.threads));
   }
-  const std::string load_before = load_average();
-  const std::string date = utc_now();
+  const std::string load_before = experiment::load_average();
+  const std::string date = experiment::utc_now();
   // The report is rewritten after every scene, so a run cut short keeps the scenes it finished.
   std::vector<SceneResult> results;
   for (const auto& [file, frames] : scenes) {
@@ -320,9 +270,10 @@ int run_in_situ(const InSituArgs& a) {
         "- load average (1, 5, 15 min): {} before, {} after\n"
         "- scenes: {} of {} done\n"
         "- per-frame figures: {}\n\n",
-        a.command, commit(), ::sysconf(_SC_NPROCESSORS_ONLN), cpu_model(),
-        a.threads > 0 ? fmt::format("{}", a.threads) : std::string("all"), date, load_before,
-        load_average(), results.size(), scenes.size(), csv_path.filename().string());
+        a.command, experiment::git_commit(source_dir()), ::sysconf(_SC_NPROCESSORS_ONLN),
+        experiment::cpu_model(), a.threads > 0 ? fmt::format("{}", a.threads) : std::string("all"),
+        date, load_before, experiment::load_average(), results.size(), scenes.size(),
+        csv_path.filename().string());
     std::string csv =
         "scene,setting,frame,substeps,frame_s,collision_s,self_ccd_calls,triangle_pairs,"
         "nodes_culled,refit_s,traversal_s,narrow_s,proximity_calls,proximity_reused_pairs,"

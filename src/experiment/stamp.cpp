@@ -25,7 +25,9 @@ std::string shell_line(const std::string& cmd) {
   return out;
 }
 
-std::string commit(const std::filesystem::path& dir) {
+}  // namespace
+
+std::string git_commit(const std::filesystem::path& dir) {
   const std::string d = dir.string();
   if (d.find('\'') != std::string::npos) return "unknown";
   const std::string head = shell_line(fmt::format("git -C '{}' rev-parse HEAD 2>/dev/null", d));
@@ -55,8 +57,6 @@ std::string utc_now() {
   return buf.data();
 }
 
-}  // namespace
-
 std::string load_average() {
   std::ifstream in("/proc/loadavg");
   std::string a, b, c;
@@ -69,8 +69,8 @@ std::string stamp(const std::string& command, const std::filesystem::path& sourc
   return fmt::format(
       "- command: `{}`\n- commit: {}\n- machine: {} cores ({}); worker threads: {}\n"
       "- started: {}; load average (1, 5, 15 min) at the start: {}\n",
-      command, commit(source_dir), ::sysconf(_SC_NPROCESSORS_ONLN), cpu_model(), threads, utc_now(),
-      load_average());
+      command, git_commit(source_dir), ::sysconf(_SC_NPROCESSORS_ONLN), cpu_model(), threads,
+      utc_now(), load_average());
 }
 
 }  // namespace clothcd::experiment

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "support/file_size_limit.hpp"
+#include "support/files.hpp"
 
 namespace clothcd {
 namespace {
@@ -41,10 +42,7 @@ struct TempDir {
   }
 };
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using clothcd::test::slurp;
 
 // The message of the OutputError `f` throws; fails the test when it throws nothing.
 template <class F>

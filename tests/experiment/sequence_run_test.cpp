@@ -16,6 +16,7 @@
 #include "clothcd/experiment/experiment.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/sim/intersections.hpp"
+#include "support/files.hpp"
 
 namespace {
 
@@ -24,20 +25,10 @@ using namespace clothcd;
 using namespace clothcd::experiment;
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() /
-                     ("clothcd_sequence_run_test_" + name + "_" +
-                      std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
+  return clothcd::test::fresh_temp_dir("clothcd_sequence_run_test", name);
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using clothcd::test::slurp;
 
 std::vector<StepRow> rows_of(const ExperimentOptions& opt, const Sequence& seq, const char* b) {
   return read_step_rows(opt.out / "runs" / seq.name / (std::string(b) + ".csv"));

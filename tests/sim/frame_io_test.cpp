@@ -13,6 +13,7 @@
 #include "clothcd/sim/frame_io.hpp"
 #include "hash.hpp"
 #include "sim/scene_json.hpp"
+#include "support/files.hpp"
 
 namespace clothcd::sim {
 namespace {
@@ -30,10 +31,7 @@ Scene test_scene() {
                      "resume-test.json");
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using clothcd::test::slurp;
 
 struct TempDir {
   fs::path path =

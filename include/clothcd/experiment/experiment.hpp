@@ -119,6 +119,13 @@ void write_reports(const std::vector<Sequence>& scenes, const ExperimentOptions&
                                 const std::string& threads);
 /// The 1, 5 and 15 minute load averages ("unknown" where /proc/loadavg is missing).
 [[nodiscard]] std::string load_average();
+/// The git commit checked out in `dir`, marked when tracked files have uncommitted changes;
+/// "unknown" without git or a repository.
+[[nodiscard]] std::string git_commit(const std::filesystem::path& dir);
+/// The CPU model from /proc/cpuinfo ("unknown" where it is missing).
+[[nodiscard]] std::string cpu_model();
+/// The current date and time, "YYYY-MM-DD HH:MM:SS UTC".
+[[nodiscard]] std::string utc_now();
 
 [[nodiscard]] std::vector<StepRow> read_step_rows(const std::filesystem::path& csv);
 [[nodiscard]] std::vector<SpreadRow> read_spread_rows(const std::filesystem::path& csv);
