@@ -41,7 +41,7 @@ struct ContactHandler::Impl {
 
   void prepare(const SubstepContext& ctx) {
     const bool body = has_body(ctx);
-    geometry.start(ctx, body);
+    geometry.start(ctx);
     ccd.excluded = 0;
     // The crossing count and the escapes need the body's topology, which its detector holds.
     if (body) detectors.start_body(ctx, geometry);

@@ -34,7 +34,7 @@ std::string state_name(int frame) {
 
 // The commit point of a frame (see run_simulation).
 void write_manifest(const std::filesystem::path& path, const nlohmann::json& manifest) {
-  write_file_atomic(path, manifest.dump(1) + '\n', Durability::sync);
+  write_file_atomic(path, manifest.dump(1) + '\n', Durability::Sync);
 }
 
 // What a killed run can leave: temporary files of the atomic writer (and the fixed `NAME.tmp` of
@@ -174,7 +174,7 @@ void write_mesh_atomic(const std::filesystem::path& path, const std::vector<Vec3
       out.write(s.data(), static_cast<std::streamsize>(s.size()));
     }
   };
-  write_file_atomic(path, body, Durability::sync);
+  write_file_atomic(path, body, Durability::Sync);
 }
 
 void write_state_atomic(const std::filesystem::path& path, const ClothState& state, int frame) {
@@ -187,7 +187,7 @@ void write_state_atomic(const std::filesystem::path& path, const ClothState& sta
     put_vecs(out, state.v);
     put_vecs(out, state.dv);
   };
-  write_file_atomic(path, body, Durability::sync);
+  write_file_atomic(path, body, Durability::Sync);
 }
 
 ClothState read_state(const std::filesystem::path& path, int num_vertices, int& frame) {

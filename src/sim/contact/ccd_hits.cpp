@@ -42,9 +42,8 @@ std::vector<Contact> CcdHits::find(std::span<const Vec3> v, const std::vector<in
   std::vector<Vec3> x1(g_.x0.size());
   for (std::size_t i = 0; i < g_.x0.size(); ++i)
     x1[i] = g_.x0[i] + g_.h * v[i];
-  const Positions x1m = to_matrix(x1);
-  if (self) self_hits(x1m, x1, v, active, out);
-  if (body) body_hits(x1m, x1, v, active, out);
+  if (self) self_hits(x1, v, active, out);
+  if (body) body_hits(x1, v, active, out);
   return out;
 }
 
@@ -96,7 +95,7 @@ CcdHits::Hit CcdHits::settle(bool dropped, bool tangled, double toi, const Query
   return r;
 }
 
-void CcdHits::self_hits(const Positions& x1m, std::span<const Vec3> x1, std::span<const Vec3> v,
+void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
                         const std::vector<int>* active, std::vector<Contact>& out) {
   SelfDetector& det = det_.self();
   if (active != nullptr) {
@@ -104,7 +103,7 @@ void CcdHits::self_hits(const Positions& x1m, std::span<const Vec3> x1, std::spa
   } else {
     det.clear_active_faces();
   }
-  const DetectResult r = det.detect(g_.x0m, x1m);
+  const DetectResult r = det.detect(g_.x0, x1);
   if (active == nullptr) {
     det_.self_pass_done();
     SelfCcdFigures& f = det_.self_ccd_figures;
@@ -152,7 +151,7 @@ void CcdHits::self_hits(const Positions& x1m, std::span<const Vec3> x1, std::spa
 // Cloth-body hits, each settled like a self hit. Its distance at t0 is measured within the reach
 // of the pair's motion (a pair farther apart cannot touch), the measure the separation of a
 // resting pair is taken from.
-void CcdHits::body_hits(const Positions& x1m, std::span<const Vec3> x1, std::span<const Vec3> v,
+void CcdHits::body_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
                         const std::vector<int>* active, std::vector<Contact>& out) {
   PairDetector& det = det_.body();
   if (active != nullptr) {
@@ -160,7 +159,7 @@ void CcdHits::body_hits(const Positions& x1m, std::span<const Vec3> x1, std::spa
   } else {
     det.clear_active();
   }
-  const PairDetectResult r = det.detect(g_.x0m, x1m, g_.b0m, g_.b1m);
+  const PairDetectResult r = det.detect(g_.x0, x1, g_.b0, g_.b1);
   const auto& cf = g_.cloth().faces();
   const auto& bf = g_.body().faces();
   const auto& ce = g_.cloth().edges();

@@ -40,10 +40,10 @@ class CcdHits {
   };
 
  private:
-  void self_hits(const Positions& x1m, std::span<const Vec3> x1, std::span<const Vec3> v,
-                 const std::vector<int>* active, std::vector<Contact>& out);
-  void body_hits(const Positions& x1m, std::span<const Vec3> x1, std::span<const Vec3> v,
-                 const std::vector<int>* active, std::vector<Contact>& out);
+  void self_hits(std::span<const Vec3> x1, std::span<const Vec3> v, const std::vector<int>* active,
+                 std::vector<Contact>& out);
+  void body_hits(std::span<const Vec3> x1, std::span<const Vec3> v, const std::vector<int>* active,
+                 std::vector<Contact>& out);
   template <class Query, class Distance, class Make>
   Hit settle(bool dropped, bool tangled, double toi, const Query& query, Distance&& d0, Make&& make,
              double reach) const;

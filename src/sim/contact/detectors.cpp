@@ -27,9 +27,9 @@ SelfDetector& ContactDetectors::start_self(const ContactGeometry& g) {
     o.reuse_distance = opt_.thickness;
     // Seam-linked vertices count as one point: the seam's sides touch by design.
     o.linked_vertices = model_.seam_links();
-    self_.emplace(model_.topology().faces(), model_.num_vertices(), g.x0m, o);
+    self_.emplace(model_.topology().faces(), model_.num_vertices(), g.x0, o);
   } else if (self_fit_ > 0.0 && FittedTree::loosened(self_->bvh().box_area_ratio(), self_fit_)) {
-    self_->rebuild(g.x0m);  // its boxes are still the last CCD pass's
+    self_->rebuild(g.x0);  // its boxes are still the last CCD pass's
     self_fit_ = 0.0;
   }
   return *self_;
@@ -41,8 +41,8 @@ void ContactDetectors::self_pass_done() {
 
 PairDetector& ContactDetectors::start_body(const SubstepContext& ctx, ContactGeometry& g) {
   if (!body_) {
-    body_.emplace(model_.topology().faces(), model_.num_vertices(), g.x0m, *ctx.body_faces,
-                  static_cast<int>(ctx.body_t0.size()), g.b0m, ccd_detect_options(opt_));
+    body_.emplace(model_.topology().faces(), model_.num_vertices(), g.x0, *ctx.body_faces,
+                  static_cast<int>(ctx.body_t0.size()), g.b0, ccd_detect_options(opt_));
   }
   g.set_body(&body_->topology_b());
   return *body_;
@@ -57,7 +57,7 @@ void ContactDetectors::body_proximity_done(const ContactGeometry& g) {
   }
   if (FittedTree::loosened(ratio[0], body_fit_[0]) ||
       FittedTree::loosened(ratio[1], body_fit_[1])) {
-    body_->rebuild(g.x0m, g.b0m);
+    body_->rebuild(g.x0, g.b0);
     body_fit_ = {0.0, 0.0};
   }
 }

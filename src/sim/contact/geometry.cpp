@@ -5,13 +5,6 @@
 
 namespace clothcd::sim::detail {
 
-Positions to_matrix(std::span<const Vec3> x) {
-  Positions m(static_cast<Eigen::Index>(x.size()), 3);
-  for (std::size_t i = 0; i < x.size(); ++i)
-    m.row(static_cast<Eigen::Index>(i)) = x[i].transpose();
-  return m;
-}
-
 bool normalize(Vec3& n) {
   const double l = n.norm();
   if (!(l > 1e-14)) return false;
@@ -22,17 +15,12 @@ bool normalize(Vec3& n) {
 ContactGeometry::ContactGeometry(const ClothModel& model)
     : model_(model), links_(model.num_vertices(), model.seam_links()) {}
 
-void ContactGeometry::start(const SubstepContext& ctx, bool with_body) {
+void ContactGeometry::start(const SubstepContext& ctx) {
   x0 = ctx.x0;
   b0 = ctx.body_t0;
   b1 = ctx.body_t1;
   h = ctx.h;
   inv_mass = ctx.inverse_mass;
-  x0m = to_matrix(x0);
-  if (with_body) {
-    b0m = to_matrix(b0);
-    b1m = to_matrix(b1);
-  }
 }
 
 void ContactGeometry::start_response(bool with_body) {

@@ -25,7 +25,6 @@ struct Contact {
   double sep = 0.0;  // CCD separation this pair was tested with
 };
 
-Positions to_matrix(std::span<const Vec3> x);
 // Scales n to unit length; false (n unchanged) when it is too short to have a direction.
 bool normalize(Vec3& n);
 
@@ -34,8 +33,8 @@ class ContactGeometry {
  public:
   explicit ContactGeometry(const ClothModel& model);
 
-  /// Takes the substep's positions (the body's when `with_body`).
-  void start(const SubstepContext& ctx, bool with_body);
+  /// Takes the substep's positions (the cloth's and the body's; no copy).
+  void start(const SubstepContext& ctx);
   /// The body's velocities over the substep (zero without a body).
   void start_response(bool with_body);
   /// The body's topology, once known (the contact stage's body detector owns it).
@@ -67,9 +66,8 @@ class ContactGeometry {
   bool make_ee(Contact& c, int ea, bool a_body, int eb, bool b_body, double tau,
                std::span<const Vec3> v) const;
 
-  // The substep: positions, their matrices for the detectors, body velocities, masses.
+  // The substep: positions, body velocities, masses.
   std::span<const Vec3> x0, b0, b1;
-  Positions x0m, b0m, b1m;
   std::vector<Vec3> vb;
   std::span<const double> inv_mass;
   double h = 0.0;

@@ -17,7 +17,7 @@ void ProximityContacts::find(ContactDetectors& detectors, const Escapes& escapes
   if (self) {
     SelfDetector& det = detectors.start_self(g_);
     const auto t = std::chrono::steady_clock::now();
-    const ProximityResult r = det.proximity(g_.x0m, opt_.thickness);
+    const ProximityResult r = det.proximity(g_.x0, opt_.thickness);
     SelfProximityFigures& f = detectors.self_proximity_figures;
     f.query_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
     ++f.calls;
@@ -42,7 +42,7 @@ void ProximityContacts::find_body(ContactDetectors& detectors, const Escapes& es
   const std::span<const Vec3> none;
   PairDetector& det = detectors.body();
   det.clear_active();
-  const PairProximityResult r = det.proximity(g_.x0m, g_.b0m, opt_.thickness);
+  const PairProximityResult r = det.proximity(g_.x0, g_.b0, opt_.thickness);
   detectors.body_proximity_done(g_);
   const auto& cf = g_.cloth().faces();
   const auto& ce = g_.cloth().edges();
