@@ -71,9 +71,9 @@ int run(const Args& args) {
   for (const auto& f : files) {
     QueryKind kind;
     if (args.type == "vf") {
-      kind = QueryKind::vertex_face;
+      kind = QueryKind::VertexFace;
     } else if (args.type == "ee") {
-      kind = QueryKind::edge_edge;
+      kind = QueryKind::EdgeEdge;
     } else if (auto k = clothcd::query_kind_from_path(f)) {
       kind = *k;
     } else {

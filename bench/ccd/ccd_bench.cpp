@@ -35,7 +35,7 @@ std::vector<Item> random_set(bool colliding, int n, std::uint64_t seed) {
   std::vector<Item> out;
   for (int i = 0; i < n; ++i) {
     const bool vf = i % 2 == 0;
-    Item it{vf ? QueryKind::vertex_face : QueryKind::edge_edge, {}};
+    Item it{vf ? QueryKind::VertexFace : QueryKind::EdgeEdge, {}};
     auto& p = it.q.points;
     const double ts = 0.1 + 0.8 * u01(rng);
     for (int k = 1; k < 4; ++k)
@@ -121,7 +121,7 @@ void BM_Ccd(benchmark::State& state) {
   opt.fast_path = mode != inclusion_only;
   auto run_one = [&](const Item& it) {
     if (mode == np_only) {
-      return !(it.kind == QueryKind::vertex_face
+      return !(it.kind == QueryKind::VertexFace
                    ? clothcd::np_filter_culls(clothcd::to_vertex_face(it.q))
                    : clothcd::np_filter_culls(clothcd::to_edge_edge(it.q)));
     }
@@ -139,7 +139,7 @@ void BM_Ccd(benchmark::State& state) {
     fp += !it.q.truth && hit;
     if (mode != np_only) {
       const auto r = clothcd::run_query(it.kind, it.q, opt);
-      certified += r.path == clothcd::CcdPath::certified;
+      certified += r.path == clothcd::CcdPath::Certified;
       no_boxes += r.boxes == 0;
       boxes += r.boxes;
     }

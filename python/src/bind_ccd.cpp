@@ -125,9 +125,9 @@ void bind_ccd(py::module_& m) {
         QueryKind k;
         if (kind) {
           if (*kind == "vertex-face" || *kind == "vf") {
-            k = QueryKind::vertex_face;
+            k = QueryKind::VertexFace;
           } else if (*kind == "edge-edge" || *kind == "ee") {
-            k = QueryKind::edge_edge;
+            k = QueryKind::EdgeEdge;
           } else {
             fail(fmt::format("kind: unknown value '{}' (one of vertex-face, edge-edge)", *kind));
           }
@@ -152,7 +152,7 @@ void bind_ccd(py::module_& m) {
               p[24 * i + 3 * r + c] = file.queries[i].points[r][c];
           truth.mutable_data()[i] = file.queries[i].truth;
         }
-        return py::make_tuple(q, truth, k == QueryKind::vertex_face ? "vertex-face" : "edge-edge");
+        return py::make_tuple(q, truth, k == QueryKind::VertexFace ? "vertex-face" : "edge-edge");
       },
       py::arg("path"), py::arg("kind") = py::none(),
       R"(Reads a CCD query CSV file (8 rows per query, x_num,x_den,y_num,y_den,z_num,z_den,truth).

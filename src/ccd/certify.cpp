@@ -50,7 +50,7 @@ InsideData inside_data(Kind kind, const Motion& m) {
   // EE: a0 a1 b0 b1).
   static constexpr int kVf[5][2] = {{2, 1}, {3, 1}, {0, 1}, {3, 2}, {0, 2}};  // e1 e2 r e3 s
   static constexpr int kEe[5][2] = {{1, 0}, {3, 2}, {2, 0}, {1, 2}, {0, 3}};  // ea eb d w z
-  const auto& idx = kind == Kind::vertex_face ? kVf : kEe;
+  const auto& idx = kind == Kind::VertexFace ? kVf : kEe;
   double a = 0;
   for (int k = 0; k < 5; ++k) {
     diff(m.x0[idx[k][0]], m.x0[idx[k][1]], d.x0[k]);
@@ -76,7 +76,7 @@ Inside inside_over(const InsideData& d, double lo, double hi, double& u, double&
   }
   I g[4];
   int count;
-  if (d.kind == Kind::vertex_face) {
+  if (d.kind == Kind::VertexFace) {
     const IV n = cross(x[0], x[1]);
     g[0] = dot(n, cross(x[0], x[2]));  // weight of c
     g[1] = dot(n, cross(x[3], x[4]));  // weight of a
@@ -105,10 +105,10 @@ Inside inside_over(const InsideData& d, double lo, double hi, double& u, double&
                    16384 * std::numeric_limits<double>::denorm_min();
   bool all_positive = true;
   for (int i = 0; i < count; ++i) {
-    if (g[i].m + g[i].r < -e) return Inside::outside;
+    if (g[i].m + g[i].r < -e) return Inside::No;
     all_positive = all_positive && g[i].m - g[i].r > e;
   }
-  return all_positive ? Inside::inside : Inside::unknown;
+  return all_positive ? Inside::Yes : Inside::Unknown;
 }
 
 }  // namespace clothcd::ccd_detail

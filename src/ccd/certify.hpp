@@ -26,7 +26,7 @@ struct InsideData {
 
 InsideData inside_data(Kind kind, const Motion& m);
 
-enum class Inside { outside, inside, unknown };
+enum class Inside { No, Yes, Unknown };
 
 /// Certain answer over t in [lo, hi] (dyadic bounds in [0, 1]) when it can be decided; `u`, `v`
 /// receive the contact parameters at the range's middle (VF: weights of f1 and f2; EE: positions

@@ -36,10 +36,10 @@ namespace {
 BernsteinCubic cubic_of(Kind kind, const Eigen::Vector3d* const* x0,
                         const Eigen::Vector3d* const* x1, double& a) {
   // Point indices of a, b, c, q in the motion's order.
-  const int ia = kind == Kind::vertex_face ? 1 : 0;
-  const int ib = kind == Kind::vertex_face ? 2 : 1;
-  const int ic = kind == Kind::vertex_face ? 3 : 2;
-  const int iq = kind == Kind::vertex_face ? 0 : 3;
+  const int ia = kind == Kind::VertexFace ? 1 : 0;
+  const int ib = kind == Kind::VertexFace ? 2 : 1;
+  const int ic = kind == Kind::VertexFace ? 3 : 2;
+  const int iq = kind == Kind::VertexFace ? 0 : 3;
   const V3 e1_0 = sub(*x0[ib], *x0[ia]), e2_0 = sub(*x0[ic], *x0[ia]);
   const V3 r0 = sub(*x0[iq], *x0[ia]);
   const V3 e1_1 = sub(*x1[ib], *x1[ia]), e2_1 = sub(*x1[ic], *x1[ia]);
@@ -75,7 +75,7 @@ BernsteinCubic coplanarity_cubic(Kind kind, const Motion& m) {
 
 NpVerdict unscaled_np_filter(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points) {
   for (const Eigen::Vector3d* p : points) {
-    if (!p->allFinite()) return NpVerdict::undecided;
+    if (!p->allFinite()) return NpVerdict::Undecided;
   }
   double a = 0;
   const BernsteinCubic c = cubic_of(kind, points.data(), points.data() + 4, a);
@@ -84,8 +84,8 @@ NpVerdict unscaled_np_filter(Kind kind, const std::array<const Eigen::Vector3d*,
   // adds at most denorm_min / 2, grown by at most two later factors <= 2^101, so below 2^-968 in
   // all, while the bound's slack (256 - 100) u A^3 is at least 2^-946 for A >= 2^-300.
   constexpr double kLow = 0x1p-300, kHigh = 0x1p100;
-  if (!(a >= kLow && a <= kHigh)) return NpVerdict::undecided;
-  return np_culls(c) ? NpVerdict::culled : NpVerdict::kept;
+  if (!(a >= kLow && a <= kHigh)) return NpVerdict::Undecided;
+  return np_culls(c) ? NpVerdict::Culled : NpVerdict::Kept;
 }
 
 bool np_culls(const BernsteinCubic& c) {

@@ -19,7 +19,7 @@ BernsteinCubic coplanarity_cubic(Kind kind, const Motion& m);
 /// differences are within [2^-300, 2^100] (where the same error bound holds, and the scaled
 /// cubic, an exact power-of-two multiple, gives the same answer). `undecided` when out of range
 /// or on non-finite input: then use the scaled path.
-enum class NpVerdict { culled, kept, undecided };
+enum class NpVerdict { Culled, Kept, Undecided };
 NpVerdict unscaled_np_filter(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points);
 
 /// True when every coefficient is provably of one sign: no root in [0, 1].

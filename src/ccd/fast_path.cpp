@@ -101,8 +101,8 @@ FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
     }
     double u = 0, v = 0;
     const Inside in = inside_over(data, nd.lo, nd.hi, u, v);
-    if (in == Inside::outside) continue;
-    if (in == Inside::inside && sign_change(nd.b, e)) {
+    if (in == Inside::No) continue;
+    if (in == Inside::Yes && sign_change(nd.b, e)) {
       // A root with the contact point strictly inside: a contact in this range, and none before.
       out.hit = true;
       out.certified = true;

@@ -36,7 +36,7 @@ inline void eval_corners(const Motion& m, const double (&d)[4][3], const Box& b,
       const double p1 = m.x0[1][a] + t * d[1][a];
       const double p2 = m.x0[2][a] + t * d[2][a];
       const double p3 = m.x0[3][a] + t * d[3][a];
-      if constexpr (K == Kind::vertex_face) {
+      if constexpr (K == Kind::VertexFace) {
         const double w = p0 - p1, e1 = p2 - p1, e2 = p3 - p1;
         for (int iu = 0; iu < 2; ++iu) {
           const double wu = w - (iu == 0 ? b.u0 : b.u1) * e1;
@@ -93,7 +93,7 @@ InclusionOutcome solve(const Motion& m, const InclusionParams& p) {
       continue;
     }
     // Exact: box bounds are dyadic with few bits.
-    if (K == Kind::vertex_face && b.u0 + b.v0 > 1) continue;
+    if (K == Kind::VertexFace && b.u0 + b.v0 > 1) continue;
     if (++out.boxes > p.max_boxes) {
       // Out of budget: every contact lies in a box still open, so the earliest open time is a
       // conservative time of impact.
@@ -169,7 +169,7 @@ double corner_error_bound(double max_abs) {
 }
 
 InclusionOutcome inclusion_solve(Kind kind, const Motion& m, const InclusionParams& p) {
-  return kind == Kind::vertex_face ? solve<Kind::vertex_face>(m, p) : solve<Kind::edge_edge>(m, p);
+  return kind == Kind::VertexFace ? solve<Kind::VertexFace>(m, p) : solve<Kind::EdgeEdge>(m, p);
 }
 
 }  // namespace clothcd::ccd_detail

@@ -11,7 +11,7 @@
 namespace clothcd::ccd_detail {
 
 /// Point order. VF: v, f0, f1, f2. EE: ea0, ea1, eb0, eb1.
-enum class Kind { vertex_face, edge_edge };
+enum class Kind { VertexFace, EdgeEdge };
 
 struct Motion {
   std::array<Eigen::Vector3d, 4> x0, x1;  ///< positions at t = 0 and t = 1, scaled

@@ -55,9 +55,9 @@ CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
   check_options(opt);
   // Most pairs of a detection step end here: the NP filter without building the scaled motion.
   if (opt.fast_path && opt.thickness == 0 &&
-      ccd_detail::unscaled_np_filter(kind, points) == ccd_detail::NpVerdict::culled) {
+      ccd_detail::unscaled_np_filter(kind, points) == ccd_detail::NpVerdict::Culled) {
     CcdResult r;
-    r.path = CcdPath::np_culled;
+    r.path = CcdPath::NpCulled;
     return r;
   }
   const Motion m = ccd_detail::make_motion(points);
@@ -80,7 +80,7 @@ CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
     const ccd_detail::BernsteinCubic cubic = ccd_detail::coplanarity_cubic(kind, m);
     if (ccd_detail::np_culls(cubic)) {
       CcdResult r;
-      r.path = CcdPath::np_culled;
+      r.path = CcdPath::NpCulled;
       return r;
     }
     const ccd_detail::FastOutcome o = ccd_detail::fast_path_solve(kind, m, cubic, p);
@@ -89,12 +89,12 @@ CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
     r.toi = o.hit ? o.toi : 1.0;
     r.u = o.u;
     r.v = o.v;
-    r.path = o.certified ? CcdPath::certified : CcdPath::fast_path;
+    r.path = o.certified ? CcdPath::Certified : CcdPath::FastPath;
     r.boxes = o.boxes;
     return r;
   }
   const auto o = ccd_detail::inclusion_solve(kind, m, p);
-  return from(o, CcdPath::inclusion, o.boxes);
+  return from(o, CcdPath::Inclusion, o.boxes);
 }
 
 std::array<const Eigen::Vector3d*, 8> points_of(const VertexFaceQuery& q) {
@@ -107,25 +107,25 @@ std::array<const Eigen::Vector3d*, 8> points_of(const EdgeEdgeQuery& q) {
 }  // namespace
 
 CcdResult vertex_face_ccd(const VertexFaceQuery& q, const CcdOptions& opt) {
-  return run(Kind::vertex_face, points_of(q), opt);
+  return run(Kind::VertexFace, points_of(q), opt);
 }
 
 CcdResult edge_edge_ccd(const EdgeEdgeQuery& q, const CcdOptions& opt) {
-  return run(Kind::edge_edge, points_of(q), opt);
+  return run(Kind::EdgeEdge, points_of(q), opt);
 }
 
 bool np_filter_culls(const VertexFaceQuery& q) {
-  const auto verdict = ccd_detail::unscaled_np_filter(Kind::vertex_face, points_of(q));
-  if (verdict != ccd_detail::NpVerdict::undecided) return verdict == ccd_detail::NpVerdict::culled;
+  const auto verdict = ccd_detail::unscaled_np_filter(Kind::VertexFace, points_of(q));
+  if (verdict != ccd_detail::NpVerdict::Undecided) return verdict == ccd_detail::NpVerdict::Culled;
   return ccd_detail::np_culls(
-      ccd_detail::coplanarity_cubic(Kind::vertex_face, ccd_detail::make_motion(points_of(q))));
+      ccd_detail::coplanarity_cubic(Kind::VertexFace, ccd_detail::make_motion(points_of(q))));
 }
 
 bool np_filter_culls(const EdgeEdgeQuery& q) {
-  const auto verdict = ccd_detail::unscaled_np_filter(Kind::edge_edge, points_of(q));
-  if (verdict != ccd_detail::NpVerdict::undecided) return verdict == ccd_detail::NpVerdict::culled;
+  const auto verdict = ccd_detail::unscaled_np_filter(Kind::EdgeEdge, points_of(q));
+  if (verdict != ccd_detail::NpVerdict::Undecided) return verdict == ccd_detail::NpVerdict::Culled;
   return ccd_detail::np_culls(
-      ccd_detail::coplanarity_cubic(Kind::edge_edge, ccd_detail::make_motion(points_of(q))));
+      ccd_detail::coplanarity_cubic(Kind::EdgeEdge, ccd_detail::make_motion(points_of(q))));
 }
 
 }  // namespace clothcd

@@ -136,8 +136,8 @@ QueryFile read_query_csv(const std::filesystem::path& file, QueryKind kind) {
 std::optional<QueryKind> query_kind_from_path(const std::filesystem::path& file) {
   for (auto p = file.parent_path(); !p.empty(); p = p.parent_path()) {
     const auto name = p.filename().string();
-    if (name == "vertex-face") return QueryKind::vertex_face;
-    if (name == "edge-edge") return QueryKind::edge_edge;
+    if (name == "vertex-face") return QueryKind::VertexFace;
+    if (name == "edge-edge") return QueryKind::EdgeEdge;
     if (p == p.parent_path()) break;
   }
   return std::nullopt;
@@ -178,7 +178,7 @@ EdgeEdgeQuery to_edge_edge(const CsvQuery& q) {
 }
 
 CcdResult run_query(QueryKind kind, const CsvQuery& q, const CcdOptions& opt) {
-  return kind == QueryKind::vertex_face ? vertex_face_ccd(to_vertex_face(q), opt)
+  return kind == QueryKind::VertexFace ? vertex_face_ccd(to_vertex_face(q), opt)
                                         : edge_edge_ccd(to_edge_edge(q), opt);
 }
 

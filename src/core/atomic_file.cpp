@@ -114,7 +114,7 @@ void write_file_atomic(const fs::path& path, std::string_view bytes, Durability 
     done += static_cast<std::size_t>(n);
   }
   // Otherwise, after a machine crash, the rename may have reached the disk before the data.
-  if (durability == Durability::sync && ::fsync(fd) != 0) {
+  if (durability == Durability::Sync && ::fsync(fd) != 0) {
     abandon("write failed (fsync)", errno, true);
   }
   if (::close(fd) != 0) abandon("write failed (close)", errno, false);

@@ -196,7 +196,7 @@ struct FeatureContext {
     return edge_edge_ccd(q, o);
   }
   [[nodiscard]] bool counted_np(const CcdResult& r) const {
-    return np_filter && r.path == CcdPath::np_culled;
+    return np_filter && r.path == CcdPath::NpCulled;
   }
 };
 

@@ -1,4 +1,4 @@
-// The fast path's certified hits (CcdPath::certified: a certain root of the coplanarity cubic
+// The fast path's certified hits (CcdPath::Certified: a certain root of the coplanarity cubic
 // with the contact point certainly inside over the root's time range) against the exact oracle:
 // every certified hit is a real contact, its toi is never after the first contact, and the path
 // is actually taken on transversal contacts. Contacts are planted at any time (also near 0 and 1),
@@ -121,7 +121,7 @@ TEST(CcdCertified, CertifiedHitsAreRealAndEarly) {
         if (r.hit && r.toi > 0) {
           ASSERT_FALSE(exact(p, vf, std::nextafter(r.toi, 0.0))) << "contact before toi: " << where;
         }
-        if (r.path != CcdPath::certified) continue;
+        if (r.path != CcdPath::Certified) continue;
         ASSERT_TRUE(r.hit) << where;
         ASSERT_TRUE(truth) << "certified hit without a contact: " << where;
         if (toi_tol > 0) {
@@ -174,7 +174,7 @@ TEST(CcdCertified, TransversalContactsAreCertified) {
     const CcdResult r = kernel(p, vf, {});
     ++total;
     ASSERT_TRUE(r.hit) << "#" << i;
-    certified += r.path == CcdPath::certified;
+    certified += r.path == CcdPath::Certified;
     // The contact is at ts up to the rounding of the construction.
     EXPECT_LE(r.toi, ts + 1e-9) << "#" << i;
     EXPECT_GE(r.toi, ts - std::ldexp(1.0, -13)) << "#" << i;

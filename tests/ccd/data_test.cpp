@@ -13,7 +13,7 @@ namespace clothcd {
 namespace {
 
 bool exact(QueryKind kind, const CsvQuery& q, double t_max = 1.0) {
-  return kind == QueryKind::vertex_face ? test::exact_vertex_face_contact(to_vertex_face(q), t_max)
+  return kind == QueryKind::VertexFace ? test::exact_vertex_face_contact(to_vertex_face(q), t_max)
                                         : test::exact_edge_edge_contact(to_edge_edge(q), t_max);
 }
 

@@ -52,8 +52,8 @@ TEST(CcdQueryCsv, MalformedInputNamesFileAndLine) {
 }
 
 TEST(CcdQueryCsv, KindFromFolder) {
-  EXPECT_EQ(query_kind_from_path("a/b/vertex-face/data_0_0.csv"), QueryKind::vertex_face);
-  EXPECT_EQ(query_kind_from_path("a/edge-edge/x/data.csv"), QueryKind::edge_edge);
+  EXPECT_EQ(query_kind_from_path("a/b/vertex-face/data_0_0.csv"), QueryKind::VertexFace);
+  EXPECT_EQ(query_kind_from_path("a/edge-edge/x/data.csv"), QueryKind::EdgeEdge);
   EXPECT_FALSE(query_kind_from_path("a/b/data.csv").has_value());
   EXPECT_THROW((void)find_query_files({"/nonexistent/ccd/path"}), InputError);
 }
@@ -65,8 +65,8 @@ TEST(CcdQueryCsv, RunsTheRightKernel) {
       "1,4,1,4,-1,1,1\n0,1,0,1,0,1,1\n1,1,0,1,0,1,1\n0,1,1,1,0,1,1\n";
   const auto qs = parse_query_csv(text, "t.csv");
   ASSERT_EQ(qs.size(), 1u);
-  EXPECT_TRUE(run_query(QueryKind::vertex_face, qs[0]).hit);
-  EXPECT_FALSE(run_query(QueryKind::edge_edge, qs[0]).hit);
+  EXPECT_TRUE(run_query(QueryKind::VertexFace, qs[0]).hit);
+  EXPECT_FALSE(run_query(QueryKind::EdgeEdge, qs[0]).hit);
 }
 
 }  // namespace

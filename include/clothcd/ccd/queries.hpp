@@ -49,12 +49,12 @@ struct CcdOptions {
 
 /// Which part of the kernel decided a query.
 enum class CcdPath : std::uint8_t {
-  trivial,    ///< decided before any solver (e.g. thickness larger than the query)
-  np_culled,  ///< the Bernstein coefficients of the coplanarity cubic share a sign
-  fast_path,  ///< time ranges settled by the fast path, undecided ones by inclusion restricted to
+  Trivial,    ///< decided before any solver (e.g. thickness larger than the query)
+  NpCulled,   ///< the Bernstein coefficients of the coplanarity cubic share a sign
+  FastPath,   ///< time ranges settled by the fast path, undecided ones by inclusion restricted to
               ///< them
-  inclusion,  ///< the inclusion solver over the whole of [0, 1]
-  certified,  ///< hit certified by the fast path: certain root, contact point certainly inside
+  Inclusion,  ///< the inclusion solver over the whole of [0, 1]
+  Certified,  ///< hit certified by the fast path: certain root, contact point certainly inside
 };
 
 struct CcdResult {
@@ -65,7 +65,7 @@ struct CcdResult {
   /// Parameters of the hit box's centre (VF: barycentric weights of f1 and f2; EE: position along
   /// edge a and edge b); meaningful only when hit.
   double u = 0.0, v = 0.0;
-  CcdPath path = CcdPath::trivial;
+  CcdPath path = CcdPath::Trivial;
   /// Boxes visited by the inclusion solver (0 when it did not run).
   std::uint32_t boxes = 0;
 };

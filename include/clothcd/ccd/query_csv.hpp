@@ -15,7 +15,7 @@
 
 namespace clothcd {
 
-enum class QueryKind { vertex_face, edge_edge };
+enum class QueryKind { VertexFace, EdgeEdge };
 
 struct CsvQuery {
   Eigen::Vector3d points[8];
@@ -25,7 +25,7 @@ struct CsvQuery {
 
 struct QueryFile {
   std::filesystem::path path;
-  QueryKind kind = QueryKind::vertex_face;
+  QueryKind kind = QueryKind::VertexFace;
   std::vector<CsvQuery> queries;
 };
 

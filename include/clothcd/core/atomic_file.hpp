@@ -29,19 +29,19 @@ class OutputError : public std::runtime_error {
 };
 
 enum class Durability {
-  process_crash,  ///< atomic against a killed process (the page cache survives it)
-  sync,           ///< also against a machine crash: fsync before the rename
+  ProcessCrash,  ///< atomic against a killed process (the page cache survives it)
+  Sync,          ///< also against a machine crash: fsync before the rename
 };
 
 /// Writes `bytes` to `path` atomically (see the file comment). Throws OutputError.
 void write_file_atomic(const std::filesystem::path& path, std::string_view bytes,
-                       Durability durability = Durability::process_crash);
+                       Durability durability = Durability::ProcessCrash);
 
 /// Renders the file through `body` into memory first, then writes it as above; an exception from
 /// `body` propagates before anything is written.
 void write_file_atomic(const std::filesystem::path& path,
                        const std::function<void(std::ostream&)>& body,
-                       Durability durability = Durability::process_crash);
+                       Durability durability = Durability::ProcessCrash);
 
 /// Whether `name` (a file name, no folder) is a temporary file of write_file_atomic for the target
 /// `target_name` (any target when empty): what a killed writer can leave behind.
