@@ -16,7 +16,9 @@
 #include "clothcd/core/error.hpp"
 #include "command.hpp"
 
+// A namespace of its own: the commands are compiled together (unity build).
 namespace {
+namespace ccd_queries_command {
 
 namespace fs = std::filesystem;
 using clothcd::QueryKind;
@@ -165,4 +167,5 @@ const bool registered = clothcd::app::register_command(
       return [args] { return run(*args); };
     });
 
+}  // namespace ccd_queries_command
 }  // namespace

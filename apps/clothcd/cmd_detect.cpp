@@ -23,7 +23,9 @@
 #include "command.hpp"
 #include "misses.hpp"
 
+// A namespace of its own: the commands are compiled together (unity build).
 namespace {
+namespace detect_command {
 
 namespace fs = std::filesystem;
 using namespace clothcd;
@@ -277,4 +279,5 @@ const bool registered = clothcd::app::register_command(
       return [a] { return run(*a); };
     });
 
+}  // namespace detect_command
 }  // namespace

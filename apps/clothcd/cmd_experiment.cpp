@@ -22,7 +22,9 @@
 #include "command.hpp"
 #include "in_situ.hpp"
 
+// A namespace of its own: the commands are compiled together (unity build).
 namespace {
+namespace experiment_command {
 
 namespace fs = std::filesystem;
 using namespace clothcd;
@@ -380,4 +382,5 @@ const bool registered = clothcd::app::register_command(
       };
     });
 
+}  // namespace experiment_command
 }  // namespace

@@ -13,7 +13,9 @@
 #include "clothcd/sim/scene.hpp"
 #include "command.hpp"
 
+// A namespace of its own: the commands are compiled together (unity build).
 namespace {
+namespace render_command {
 
 namespace fs = std::filesystem;
 
@@ -106,4 +108,5 @@ const bool registered = clothcd::app::register_command(
       return [args]() { return run(*args); };
     });
 
+}  // namespace render_command
 }  // namespace

@@ -14,7 +14,9 @@
 #include "clothcd/sim/simulation.hpp"
 #include "command.hpp"
 
+// A namespace of its own: the commands are compiled together (unity build).
 namespace {
+namespace simulate_command {
 
 struct SimulateArgs {
   std::string scene;
@@ -160,4 +162,5 @@ const bool registered = clothcd::app::register_command(
       };
     });
 
+}  // namespace simulate_command
 }  // namespace

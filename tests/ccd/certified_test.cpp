@@ -24,29 +24,29 @@ namespace {
 using V = Eigen::Vector3d;
 using Points = std::array<V, 8>;
 
-struct Gen {
+struct CertifiedGen {
   std::mt19937_64 rng;
-  explicit Gen(std::uint64_t seed) : rng(seed) {}
+  explicit CertifiedGen(std::uint64_t seed) : rng(seed) {}
   double uniform(double lo, double hi) { return std::uniform_real_distribution<>(lo, hi)(rng); }
   int integer(int lo, int hi) { return std::uniform_int_distribution<>(lo, hi)(rng); }
   V vec(double s) { return V(uniform(-s, s), uniform(-s, s), uniform(-s, s)); }
 };
 
 // A contact parameter: well inside, or within 2^-k of the boundary value 0 (either side).
-double parameter(Gen& g) {
+double parameter(CertifiedGen& g) {
   if (g.integer(0, 2) > 0) return g.uniform(0.1, 0.4);
   const double d = std::ldexp(1.0, -g.integer(5, 40));
   return g.integer(0, 1) == 0 ? d : -d;
 }
 
 // Contact time: anywhere, or within 2^-k of 0 or 1.
-double contact_time(Gen& g) {
+double contact_time(CertifiedGen& g) {
   if (g.integer(0, 2) > 0) return g.uniform(0.05, 0.95);
   const double d = std::ldexp(1.0, -g.integer(4, 30));
   return g.integer(0, 1) == 0 ? d : 1 - d;
 }
 
-Points planted(Gen& g, bool vf) {
+Points planted_certified(CertifiedGen& g, bool vf) {
   const double s = std::ldexp(1.0, g.integer(-30, 30));
   const V shift = g.vec(s * std::ldexp(1.0, g.integer(0, 8)));
   Points p;
@@ -100,10 +100,10 @@ CcdResult kernel(const Points& p, bool vf, const CcdOptions& opt) {
 TEST(CcdCertified, CertifiedHitsAreRealAndEarly) {
   int certified = 0, positives = 0, tight = 0, queries = 0;
   for (std::uint64_t seed = 1; seed <= 4; ++seed) {
-    Gen g(seed);
+    CertifiedGen g(seed);
     for (int i = 0; i < CLOTHCD_CCD_CERTIFIED_COUNT; ++i) {
       const bool vf = i % 2 == 0;
-      const Points p = planted(g, vf);
+      const Points p = planted_certified(g, vf);
       const bool truth = exact(p, vf);
       ++queries;
       positives += truth;
@@ -142,7 +142,7 @@ TEST(CcdCertified, CertifiedHitsAreRealAndEarly) {
 // Transversal contacts that are certain by construction (no rounding to a grid): well inside,
 // at a random time; each must be certified, with a toi at most 2^-13 before the contact time.
 TEST(CcdCertified, TransversalContactsAreCertified) {
-  Gen g(77);
+  CertifiedGen g(77);
   int certified = 0, total = 0;
   for (int i = 0; i < 400; ++i) {
     const bool vf = i % 2 == 0;

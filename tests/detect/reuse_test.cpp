@@ -44,7 +44,7 @@ void expect_same(const ProximityResult& r, const ProximityResult& ref) {
     EXPECT_EQ(r.ee[i].distance, ref.ee[i].distance);
 }
 
-std::vector<ProceduralScene> scenes() {
+std::vector<ProceduralScene> reuse_scenes() {
   return {crumpled_sheet(8, 2), twisted_strip(30, 3), stacked_sheets(6)};
 }
 
@@ -59,7 +59,7 @@ TEST(ProximityReuse, EqualsAllPairsDistance) {
       {"none moved", 0.0, kKept, true},  {"none moved, nearer", 0.0, 0.01, true},
       {"a few moved", 0.1, 0.01, true},  {"a few moved, at the kept distance", 0.1, kKept, true},
       {"most moved", 0.6, kKept, false}, {"farther than kept", 0.0, 1.2 * kKept, false}};
-  for (const auto& s : scenes()) {
+  for (const auto& s : reuse_scenes()) {
     const Topology topo(s.faces, s.num_vertices);
     const Positions end = 0.5 * (s.v_t0 + s.v_t1);  // folded: features come close
     for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
@@ -101,7 +101,7 @@ TEST(ProximityReuse, KeptAcrossRestrictedPasses) {
   DetectOptions thick;
   thick.culling = Culling::Sound;
   thick.thickness = 1e-3;
-  for (const auto& s : scenes()) {
+  for (const auto& s : reuse_scenes()) {
     for (DetectOptions o : {DetectOptions{}, thick}) {
       SCOPED_TRACE(::testing::Message() << s.name << " thickness " << o.thickness);
       const Topology topo(s.faces, s.num_vertices);
@@ -213,7 +213,7 @@ TEST(ProximityReuse, OffWhereItCannotHold) {
 // the pairs it keeps still serve the proximity query: cones and reuse work together.
 TEST(ProximityReuse, SoundCullingKeepsWhatTheQueryNeeds) {
   std::uint64_t culled = 0, reused = 0;
-  for (const ProceduralScene& s : scenes()) {
+  for (const ProceduralScene& s : reuse_scenes()) {
     for (const double reuse : {0.002, kKept}) {
       SCOPED_TRACE(::testing::Message() << s.name << " reuse distance " << reuse);
       const Topology topo(s.faces, s.num_vertices);

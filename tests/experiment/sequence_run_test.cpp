@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 using namespace clothcd;
 using namespace clothcd::experiment;
 
-fs::path temp_dir(const std::string& name) {
+fs::path sequence_temp_dir(const std::string& name) {
   return clothcd::test::fresh_temp_dir("clothcd_sequence_run_test", name);
 }
 
@@ -41,13 +41,13 @@ TEST(ExperimentSequence, EveryEthCallRunsThoseFramePairsOnly) {
   ExperimentOptions opt;
   opt.builds = {BvhBuild::Patch};
   opt.optimal_every = 1;
-  opt.out = temp_dir("every_all");
+  opt.out = sequence_temp_dir("every_all");
   run_sequence(all, opt);
   const auto full = rows_of(opt, all, "patch");
   const auto full_spread = read_spread_rows(opt.out / "runs" / all.name / "patch.spread.csv");
   fs::remove_all(opt.out);
 
-  opt.out = temp_dir("every_2");
+  opt.out = sequence_temp_dir("every_2");
   int ran = 0;
   run_sequence(strided, opt, [&](const Progress& p) { ran += p.ran ? 1 : 0; });
   EXPECT_EQ(ran, 3);  // calls 0, 2, 4 of 5
@@ -94,7 +94,7 @@ TEST(ExperimentSequence, EveryEthCallRunsThoseFramePairsOnly) {
 TEST(ExperimentSequence, TimingPassRepeatsEveryConfigurationPerThreadCount) {
   const Sequence seq = folding_sheet(6, 4);
   ExperimentOptions opt;
-  opt.out = temp_dir("timing");
+  opt.out = sequence_temp_dir("timing");
   opt.builds = {BvhBuild::Spatial};
   opt.optimal_every = 0;
   opt.timing_every = 3;  // calls 0 and 3
@@ -169,7 +169,7 @@ TEST(ExperimentSequence, CrossingsMatchTheBruteForceIntersectionCheck) {
 
 TEST(ExperimentSequence, SimulatorFoldersCarryTheManifestsCounts) {
   const Sequence seq = folding_sheet(4, 2);
-  const fs::path dir = temp_dir("manifest");
+  const fs::path dir = sequence_temp_dir("manifest");
   for (int k = 0; k <= seq.steps(); ++k) {
     TriangleMesh m;
     m.faces = seq.faces;

@@ -18,6 +18,11 @@
 
 extern char** environ;
 
+// The built binary's path, defined by the build where the command-line tool is built.
+#ifndef CLOTHCD_CLI
+#define CLOTHCD_CLI ""
+#endif
+
 namespace clothcd::test {
 
 struct CliResult {

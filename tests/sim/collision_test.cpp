@@ -13,7 +13,7 @@
 namespace clothcd::sim {
 namespace {
 
-Vec3 momentum(const ClothModel& m, const std::vector<Vec3>& v) {
+Vec3 total_momentum(const ClothModel& m, const std::vector<Vec3>& v) {
   Vec3 p = Vec3::Zero();
   for (int i = 0; i < m.num_vertices(); ++i)
     p += m.mass()[i] * v[i];
@@ -94,7 +94,7 @@ TEST(ContactHandler, StopsTwoTrianglesCrossing) {
     const DetectResult r = d.detect(to_matrix(m.initial_positions()), to_matrix(x1));
     ASSERT_FALSE(r.vf.empty() && r.ee.empty());
   }
-  const Vec3 p0 = momentum(m, v);
+  const Vec3 p0 = total_momentum(m, v);
   const OneStep s = one_step(m, v, h);
   EXPECT_GT(s.stats.ccd_hits, 0);
   // Nothing crosses along the corrected motion, and the upper triangle stays above.
@@ -105,7 +105,7 @@ TEST(ContactHandler, StopsTwoTrianglesCrossing) {
   for (int i = 3; i < 6; ++i)
     EXPECT_GT(s.x1[i].y(), s.x1[0].y());
   // Pair impulses are internal: momentum is unchanged.
-  EXPECT_LT((momentum(m, s.v) - p0).norm(), 1e-12);
+  EXPECT_LT((total_momentum(m, s.v) - p0).norm(), 1e-12);
 }
 
 TEST(ContactHandler, RepelsWithinThicknessWithoutPopping) {
@@ -400,7 +400,7 @@ TEST(ContactHandler, SqueezedStackIsResolvedByTheProjectionAlone) {
     v[i] = Vec3(0.0, 1.5, 0.0);
     v[8 + i] = Vec3(0.0, -1.5, 0.0);
   }
-  const Vec3 p0 = momentum(m, v);
+  const Vec3 p0 = total_momentum(m, v);
   const OneStep s = one_step(m, v, 0.01);
   EXPECT_GT(s.stats.ccd_hits, 0);
   EXPECT_EQ(s.stats.zone_rounds, 0);
@@ -416,7 +416,7 @@ TEST(ContactHandler, SqueezedStackIsResolvedByTheProjectionAlone) {
     y[k] = 0.5 * (s.x1[4 * k].y() + s.x1[4 * k + 2].y());
   EXPECT_LT(y[0], y[1]);
   EXPECT_LT(y[1], y[2]);
-  EXPECT_LT((momentum(m, s.v) - p0).norm(), 1e-12);
+  EXPECT_LT((total_momentum(m, s.v) - p0).norm(), 1e-12);
 }
 
 TEST(ContactHandler, AnchoredZoneFollowsTheBodyWhereItTouchesIt) {
