@@ -3,7 +3,8 @@
 /// Research options of the self detector (DetectOptions::research): settings that reproduce the
 /// paper's measurements (Han, Lee, Lee and Ko, Eurographics 2021) and check a culling rule
 /// against unculled detection. A simulator leaves them at their defaults: the unsound rules can
-/// miss collisions, and the other options cost time without changing any result.
+/// miss collisions, and the other options cost time without changing what Culling::None and
+/// Culling::Sound report.
 /// clothcd/research/names.hpp names every setting, research ones included, as the command-line
 /// tool, the Python module and the experiment spell them.
 
@@ -43,7 +44,7 @@ struct Options {
 
 /// What Options::verify found (DetectResult::verification).
 struct Verification {
-  bool ran = false;  ///< verify was set and the detection culled; otherwise the rest is empty
+  bool ran = false;  ///< verify was set and a culling rule ran; otherwise the rest is empty
   /// Collisions the unculled detection reports and the culled one does not, sorted like
   /// DetectResult::vf and ee. Always empty with Culling::Sound.
   std::vector<VertexFaceCollision> missed_vf;
