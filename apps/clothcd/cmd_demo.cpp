@@ -23,6 +23,7 @@
 #include "clothcd/detect/names.hpp"
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/geometry/cone.hpp"
+#include "clothcd/research/names.hpp"
 #include "command.hpp"
 #include "misses.hpp"
 
@@ -301,14 +302,15 @@ int run_detection_demo(const DemoArgs& a) {
         st.time_traverse, st.time_narrow);
   };
   row("none", "-", none);
-  const std::pair<const char*, Culling> modes[] = {
-      {"cone", Culling::Cone}, {"gated", Culling::Gated}, {"sound", Culling::Sound}};
+  using research::CullingRule;
+  const std::pair<const char*, CullingRule> modes[] = {
+      {"cone", CullingRule::Cone}, {"gated", CullingRule::Gated}, {"sound", CullingRule::Sound}};
   const std::pair<const char*, ConePolicy> policies[] = {{"PROVOT", ConePolicy::Provot},
                                                          {"PROPOSED", ConePolicy::Proposed},
                                                          {"EXACT", ConePolicy::Exact}};
   for (const auto& [mname, mode] : modes) {
     for (const auto& [pname, policy] : policies) {
-      o.culling = mode;
+      research::set_culling_rule(o, mode);
       o.policy = policy;
       det.set_options(o);
       row(mname, pname, det.detect(s.v_t0, s.v_t1));

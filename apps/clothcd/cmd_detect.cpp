@@ -20,6 +20,7 @@
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/sewing.hpp"
+#include "clothcd/research/names.hpp"
 #include "command.hpp"
 #include "misses.hpp"
 
@@ -115,9 +116,11 @@ void print_table(const TriangleMesh& w0, const TriangleMesh& w1, double thicknes
                  bool with_optimal) {
   const Positions p0 = vertices_matrix(w0), p1 = vertices_matrix(w1);
   const BvhBuild builds[] = {BvhBuild::Spatial, BvhBuild::Patch};
-  const Culling modes[] = {Culling::Cone, Culling::Gated, Culling::Sound};
-  const ConePolicy policies[] = {ConePolicy::Provot, ConePolicy::Proposed, ConePolicy::Exact,
-                                 ConePolicy::Optimal};
+  using research::ConeRule;
+  using research::CullingRule;
+  const CullingRule modes[] = {CullingRule::Cone, CullingRule::Gated, CullingRule::Sound};
+  const ConeRule policies[] = {ConeRule::Provot, ConeRule::Proposed, ConeRule::Exact,
+                               ConeRule::Optimal};
   fmt::print(
       "\n| bvh | culling | policy | connected / disk internal nodes | triangle pairs | pairs "
       "culled "
@@ -131,13 +134,14 @@ void print_table(const TriangleMesh& w0, const TriangleMesh& w1, double thicknes
     const DetectResult none = det.detect(p0, p1);
     std::vector<Row> rows;
     rows.push_back({to_string(build), to_string(Culling::None), "-", none});
-    for (const Culling mode : modes) {
-      for (const ConePolicy policy : policies) {
-        if (policy == ConePolicy::Optimal && !with_optimal) continue;
-        o.culling = mode;
-        o.policy = policy;
+    for (const CullingRule mode : modes) {
+      for (const ConeRule policy : policies) {
+        if (policy == ConeRule::Optimal && !with_optimal) continue;
+        research::set_culling_rule(o, mode);
+        research::set_cone_rule(o, policy);
         det.set_options(o);
-        rows.push_back({to_string(build), to_string(mode), to_string(policy), det.detect(p0, p1)});
+        rows.push_back({to_string(build), research::to_string(mode), research::to_string(policy),
+                        det.detect(p0, p1)});
       }
     }
     for (const Row& row : rows) {
@@ -158,14 +162,14 @@ void print_table(const TriangleMesh& w0, const TriangleMesh& w1, double thicknes
 
 int run(const Args& a) {
   DetectOptions o;
-  o.policy = parse_cone_policy(a.policy, "--policy");
-  o.culling = parse_culling(a.culling, "--culling");
+  research::set_cone_rule(o, research::parse_cone_rule(a.policy, "--policy"));
+  research::set_culling_rule(o, research::parse_culling_rule(a.culling, "--culling"));
   o.build = parse_bvh_build(a.bvh, "--bvh");
   if (!(a.thickness >= 0)) throw InputError("--thickness must be >= 0");
   if (a.weld > 0 && a.sew > 0) throw InputError("give at most one of --weld and --sew");
   if (a.table && !a.json.empty()) throw InputError("--table writes no JSON; drop --json");
   o.thickness = a.thickness;
-  o.verify = a.verify;
+  o.research.verify = a.verify;
   const auto [m0, m1] = load_frames(a);
 
   // Original id of each detector vertex (the smallest original id of a welded cluster).
@@ -214,11 +218,12 @@ int run(const Args& a) {
       s.triangle_pairs, s.triangle_pairs_apart, s.nodes_culled, s.vf_tests, s.vf_np_culled,
       s.ee_tests, s.ee_np_culled, r.vf.size(), r.ee.size(), s.time_refit, s.time_traverse,
       s.time_narrow);
-  if (r.verified) {
+  const research::Verification& ver = r.verification;
+  if (ver.ran) {
     fmt::print(
         "verify: {} VF and {} EE collisions missed against culling none ({} triangle "
         "pairs)\n",
-        r.missed_vf.size(), r.missed_ee.size(), r.unculled_triangle_pairs);
+        ver.missed_vf.size(), ver.missed_ee.size(), ver.unculled_triangle_pairs);
   }
   if (!a.json.empty()) {
     auto vf_json = [&](const std::vector<VertexFaceCollision>& list) {
@@ -242,9 +247,9 @@ int run(const Args& a) {
       return out;
     };
     nlohmann::json j{{"vf", vf_json(r.vf)}, {"ee", ee_json(r.ee)}, {"stats", stats_json(s)}};
-    if (r.verified) {
-      j["missed_vf"] = vf_json(r.missed_vf);
-      j["missed_ee"] = ee_json(r.missed_ee);
+    if (ver.ran) {
+      j["missed_vf"] = vf_json(ver.missed_vf);
+      j["missed_ee"] = ee_json(ver.missed_ee);
     }
     clothcd::app::write_json_atomically(a.json, j, 1);
   }

@@ -209,13 +209,8 @@ int run(const Args& a) {
   ExperimentOptions opt;
   opt.out = a.out;
   opt.policies.clear();
-  for (const auto& p : a.policies) {
-    const ConePolicy cp = parse_policy(p, "--policies");
-    if (cp == ConePolicy::Optimal) {
-      throw InputError("--policies: OPTIMAL is for spread angles only (see --optimal-every)");
-    }
-    opt.policies.push_back(cp);
-  }
+  for (const auto& p : a.policies)
+    opt.policies.push_back(parse_policy(p, "--policies"));
   opt.cullings.clear();
   for (const auto& c : a.cullings)
     opt.cullings.push_back(parse_culling(c, "--cullings"));

@@ -11,6 +11,7 @@
 
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/names.hpp"
 
 namespace {
 
@@ -52,17 +53,20 @@ void BM_ClothBallStep(benchmark::State& state) {
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 2);
   DetectOptions o;
   o.policy = static_cast<ConePolicy>(state.range(0));
-  o.culling = static_cast<Culling>(state.range(1));
+  const auto culling = static_cast<research::CullingRule>(state.range(1));
+  research::set_culling_rule(o, culling);
   o.build = static_cast<BvhBuild>(state.range(2));
-  o.verify = true;
+  o.research.verify = true;
   SelfDetector det(f->m0.faces, f->m0.num_vertices(), f->p0, o);
   // Check first: the sound mode misses nothing against the unculled traversal.
   const DetectResult check = det.detect(f->p0, f->p1);
-  if (o.culling == Culling::Sound && (!check.missed_vf.empty() || !check.missed_ee.empty())) {
+  const research::Verification& missed = check.verification;
+  if (culling == research::CullingRule::Sound &&
+      (!missed.missed_vf.empty() || !missed.missed_ee.empty())) {
     state.SkipWithError("sound culling missed collisions");
     return;
   }
-  o.verify = false;
+  o.research.verify = false;
   det.set_options(o);
   DetectResult r;
   // Process CPU time (all threads): on a shared, loaded machine the wall time mostly measures
@@ -81,13 +85,14 @@ void BM_ClothBallStep(benchmark::State& state) {
   state.counters["vf_hits"] = double(s.vf_collisions);
   state.counters["ee_hits"] = double(s.ee_collisions);
   state.counters["culled_nodes"] = double(s.nodes_culled);
-  state.counters["missed"] = double(check.missed_vf.size() + check.missed_ee.size());
+  state.counters["missed"] = double(missed.missed_vf.size() + missed.missed_ee.size());
   state.counters["t_refit"] = s.time_refit;
   state.counters["t_trav"] = s.time_traverse;
   state.counters["t_narrow"] = s.time_narrow;
 }
 
-// Args: policy (0 Provot, 1 Proposed, 2 Exact), culling (0 none, 1 cone, 3 sound), build.
+// Args: policy (0 Provot, 1 Proposed, 2 Exact), culling (research::CullingRule: 0 none, 1 cone,
+// 3 sound), build.
 BENCHMARK(BM_ClothBallStep)
     ->ArgNames({"policy", "culling", "bvh"})
     ->Args({1, 0, 0})

@@ -55,7 +55,7 @@ const Garment* garment(int which) {
   return g.get();
 }
 
-void refit_bench(benchmark::State& state, ConePolicy policy) {
+void refit_bench(benchmark::State& state, bool optimal) {
   const Garment* g = garment(static_cast<int>(state.range(0)));
   if (g == nullptr) {
     state.SkipWithError("garments not found (set CLOTHCD_DATA)");
@@ -65,7 +65,8 @@ void refit_bench(benchmark::State& state, ConePolicy policy) {
                               static_cast<std::size_t>(state.range(2)));
   Bvh bvh(*g->topology, g->v0, state.range(1) == 0 ? BvhBuild::Spatial : BvhBuild::Patch);
   RefitOptions o;
-  o.policy = policy;
+  o.policy = ConePolicy::Proposed;
+  o.optimal_cones = optimal;
   for (auto _ : state) {
     bvh.refit(g->v0, g->v1, o);
     benchmark::DoNotOptimize(bvh.cones().data());
@@ -84,10 +85,10 @@ void refit_bench(benchmark::State& state, ConePolicy policy) {
 }
 
 void BM_OptimalRefit(benchmark::State& state) {
-  refit_bench(state, ConePolicy::Optimal);
+  refit_bench(state, true);
 }
 void BM_ProposedRefit(benchmark::State& state) {
-  refit_bench(state, ConePolicy::Proposed);
+  refit_bench(state, false);
 }
 
 void args(benchmark::internal::Benchmark* b) {

@@ -8,6 +8,7 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
 #include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/names.hpp"
 
 namespace clothcd::python {
 namespace {
@@ -20,8 +21,9 @@ struct OptionArgs {
   std::optional<int> distance_filter_depth;
 
   void apply(DetectOptions& o) const {
-    if (policy) o.policy = parse_cone_policy(*policy, "policy");
-    if (culling) o.culling = parse_culling(*culling, "culling");
+    // Research names included ("cone", "gated", "optimal"): they set DetectOptions::research.
+    if (policy) research::set_cone_rule(o, research::parse_cone_rule(*policy, "policy"));
+    if (culling) research::set_culling_rule(o, research::parse_culling_rule(*culling, "culling"));
     if (thickness) {
       if (!(*thickness >= 0) || !std::isfinite(*thickness)) {
         fail(fmt::format("thickness must be finite and >= 0, got {}", *thickness));
@@ -38,8 +40,8 @@ struct OptionArgs {
 
 py::dict options_dict(const DetectOptions& o, const char* bvh) {
   py::dict d;
-  d["policy"] = std::string(to_string(o.policy));
-  d["culling"] = std::string(to_string(o.culling));
+  d["policy"] = std::string(research::to_string(research::cone_rule(o)));
+  d["culling"] = std::string(research::to_string(research::culling_rule(o)));
   d["bvh"] = bvh;
   d["thickness"] = o.thickness;
   d["np_filter"] = o.np_filter;
@@ -124,10 +126,11 @@ struct SelfResult {
   explicit SelfResult(const DetectResult& r) : stats(stats_dict(r.stats)) {
     std::tie(vf, vf_toi) = vf_columns(r.vf);
     std::tie(ee, ee_toi) = ee_columns(r.ee);
-    if (r.verified) {
-      missed_vf = vf_columns(r.missed_vf).first;
-      missed_ee = ee_columns(r.missed_ee).first;
-      stats["unculled_triangle_pairs"] = r.unculled_triangle_pairs;
+    const research::Verification& ver = r.verification;
+    if (ver.ran) {
+      missed_vf = vf_columns(ver.missed_vf).first;
+      missed_ee = ee_columns(ver.missed_ee).first;
+      stats["unculled_triangle_pairs"] = ver.unculled_triangle_pairs;
     }
   }
 };
@@ -225,7 +228,7 @@ class PySelfDetector {
   void set_options(const OptionArgs& args, std::optional<bool> verify) {
     DetectOptions o = det_->options();
     args.apply(o);
-    if (verify) o.verify = *verify;
+    if (verify) o.research.verify = *verify;
     workers_.run([&] { det_->set_options(o); });
   }
 
@@ -238,7 +241,7 @@ class PySelfDetector {
   [[nodiscard]] py::dict options() const {
     py::dict d = options_dict(det_->options(), bvh_.c_str());
     d["threads"] = workers_.threads();
-    d["verify"] = det_->options().verify;
+    d["verify"] = det_->options().research.verify;
     return d;
   }
 
@@ -293,9 +296,11 @@ py::tuple scene_tuple(ProceduralScene&& s) {
 
 constexpr const char* kOptionsDoc = R"(
 Options (keyword-only):
-  policy: cone policy, "provot" | "proposed" | "exact" | "optimal".
-  culling: when a node's self test may be skipped, "none" | "cone" | "gated" | "sound"
-      ("sound" finds exactly what "none" finds; "cone" and "gated" can miss collisions).
+  policy: cone policy, "provot" | "proposed" | "exact"; or, to reproduce the paper's
+      measurements, "optimal" (the reference optimal cones; slow).
+  culling: when a node's self test may be skipped, "none" | "sound" ("sound" finds exactly what
+      "none" finds); or, to reproduce the paper's measurements, the unsound rules "cone" and
+      "gated", which can miss collisions. Between two meshes only "none".
   bvh: tree build, "spatial" | "patch".
   thickness: contact distance of the kernels (>= 0); "sound" culls nothing when > 0.
   threads: worker threads (0: all cores).

@@ -20,6 +20,7 @@
 #include "clothcd/detect/oracle.hpp"
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/names.hpp"
 
 namespace {
 
@@ -36,8 +37,9 @@ int get_int(const Args& a, const std::string& key, int fallback) {
 
 DetectOptions options(const Args& a) {
   DetectOptions o;
-  o.policy = parse_cone_policy(get(a, "policy", "proposed"), "policy");
-  o.culling = parse_culling(get(a, "culling", "sound"), "culling");
+  research::set_cone_rule(o, research::parse_cone_rule(get(a, "policy", "proposed"), "policy"));
+  research::set_culling_rule(o,
+                             research::parse_culling_rule(get(a, "culling", "sound"), "culling"));
   o.build = parse_bvh_build(get(a, "bvh", "patch"), "bvh");
   o.thickness = std::stod(get(a, "thickness", "0"));
   return o;

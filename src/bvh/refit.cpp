@@ -27,7 +27,6 @@ LeafConePolicy leaf_policy(ConePolicy p) {
     case ConePolicy::Proposed:
       return LeafConePolicy::Proposed;
     case ConePolicy::Exact:
-    case ConePolicy::Optimal:
       return LeafConePolicy::Exact;
   }
   return LeafConePolicy::Exact;
@@ -59,7 +58,7 @@ void set_box(BvhNode& n, std::initializer_list<const Eigen::Vector3d*> pts) {
 template <class LeafFn>
 void Bvh::refit_levels(const RefitOptions& options, std::span<const std::uint8_t> only,
                        LeafFn&& leaf) {
-  const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
+  const bool optimal = options.cones && options.optimal_cones;
   if (optimal) {
     control_dirs_.resize(3 * prim_ids_.size());
     degenerate_.resize(prim_ids_.size());
@@ -90,7 +89,7 @@ void Bvh::refit_levels(const RefitOptions& options, std::span<const std::uint8_t
                           // wide.
                           if (cl.saturated() || cr.saturated()) {
                             cones_[i] = full_cone();
-                          } else if (options.policy == ConePolicy::Provot) {
+                          } else if (!optimal && options.policy == ConePolicy::Provot) {
                             cones_[i] = merge_provot(cl, cr);
                           } else if (!optimal) {
                             cones_[i] = merge_tight(cl, cr);
@@ -135,8 +134,10 @@ void Bvh::refit_changed(std::span<const Eigen::Vector3d> v_t0,
 void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
                       const RefitOptions& options, std::span<const std::uint8_t> nodes) {
   const double margin = 0.5 * options.thickness;
-  const LeafConePolicy lp = leaf_policy(options.policy);
-  const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
+  // Optimal cones start from exact leaf caps.
+  const LeafConePolicy lp =
+      options.optimal_cones ? LeafConePolicy::Exact : leaf_policy(options.policy);
+  const bool optimal = options.cones && options.optimal_cones;
   const auto& faces = topology_->faces();
   refit_levels(options, nodes, [&](BvhNode& n, int i) {
     const Face& t = faces[prim_ids_[n.first]];
@@ -165,7 +166,7 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
 void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options) {
   forget_changes();
   const double margin = 0.5 * options.thickness;
-  const bool optimal = options.cones && options.policy == ConePolicy::Optimal;
+  const bool optimal = options.cones && options.optimal_cones;
   const auto& faces = topology_->faces();
   refit_levels(options, {}, [&](BvhNode& n, int i) {
     const Face& t = faces[prim_ids_[n.first]];

@@ -14,6 +14,7 @@
 
 #include "clearance.hpp"
 #include "clothcd/ccd/proximity.hpp"
+#include "clothcd/research/names.hpp"
 #include "contour.hpp"
 #include "narrow.hpp"
 #include "options.hpp"
@@ -55,6 +56,9 @@ struct NarrowBuffer {
 }  // namespace
 
 struct SelfDetector::Impl {
+  // The traversal's culling rule: any of the four, the research options' unsound ones included.
+  using Culling = research::CullingRule;
+
   Topology topo;
   DetectOptions opt;
   Bvh bvh;
@@ -92,13 +96,13 @@ struct SelfDetector::Impl {
   }
 
   [[nodiscard]] bool cones_used(Culling mode) const { return mode != Culling::None; }
+  [[nodiscard]] Culling rule() const { return research::culling_rule(opt); }
 
   // Pairs kept for reuse: not with the unsound rules, which may cull close pairs. Sound culling
   // then certifies its nodes free of feature pairs within reuse_distance too (cull_reach()), so
   // the list holds every overlapping leaf pair that can matter; the boxes reach reuse_distance.
   [[nodiscard]] bool keeps() const {
-    return opt.reuse_distance > 0 &&
-           (opt.culling == Culling::None || opt.culling == Culling::Sound);
+    return opt.reuse_distance > 0 && (rule() == Culling::None || rule() == Culling::Sound);
   }
   [[nodiscard]] double box_reach() const {
     return keeps() ? std::max(opt.thickness, opt.reuse_distance) : opt.thickness;
@@ -108,7 +112,7 @@ struct SelfDetector::Impl {
   // reuse, the contour test alone proves a node free of contacts; otherwise a node must also
   // keep its non-adjacent features farther apart than the node's reach.
   [[nodiscard]] bool culls_with_reach() const {
-    return opt.culling == Culling::Sound && (opt.thickness > 0 || keeps());
+    return rule() == Culling::Sound && (opt.thickness > 0 || keeps());
   }
 
   // How close two features of node n may come before the narrow phase could report them: a
@@ -347,8 +351,9 @@ struct SelfDetector::Impl {
     auto t = Clock::now();
     RefitOptions ro;
     ro.thickness = box_reach();
-    ro.cones = cones_used(opt.culling);
+    ro.cones = cones_used(rule());
     ro.policy = opt.policy;
+    ro.optimal_cones = opt.research.optimal_cones;
     bvh.refit_changed(v0, v1, ro);
     st.time_refit = seconds_since(t);
     st.internal_nodes = bvh.num_internal();
@@ -356,7 +361,7 @@ struct SelfDetector::Impl {
     st.disk_internal_nodes = bvh.num_disk_internal();
 
     t = Clock::now();
-    auto pairs = traverse(opt.culling, st);
+    auto pairs = traverse(rule(), st);
     st.time_traverse = seconds_since(t);
     t = Clock::now();
     detail::FeatureContext ctx = ccd_context();
@@ -374,16 +379,17 @@ struct SelfDetector::Impl {
       reuse.valid = true;
     }
 
-    if (opt.verify && opt.culling != Culling::None) {
+    if (opt.research.verify && rule() != Culling::None) {
       DetectResult ref;
       const auto all = traverse(Culling::None, ref.stats);
       narrow(ctx, all, ref);
-      res.verified = true;
-      res.unculled_triangle_pairs = all.size();
+      research::Verification& ver = res.verification;
+      ver.ran = true;
+      ver.unculled_triangle_pairs = all.size();
       std::set_difference(ref.vf.begin(), ref.vf.end(), res.vf.begin(), res.vf.end(),
-                          std::back_inserter(res.missed_vf), detail::vf_less);
+                          std::back_inserter(ver.missed_vf), detail::vf_less);
       std::set_difference(ref.ee.begin(), ref.ee.end(), res.ee.begin(), res.ee.end(),
-                          std::back_inserter(res.missed_ee), detail::ee_less);
+                          std::back_inserter(ver.missed_ee), detail::ee_less);
     }
     return res;
   }

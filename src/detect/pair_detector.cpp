@@ -28,15 +28,20 @@ double seconds_since(Clock::time_point t) {
 
 // Options the two-mesh detector cannot honour are refused before any work.
 void check_pair_options(const DetectOptions& o) {
-  if (o.culling != Culling::None) {
+  if (o.culling != Culling::None || o.research.unsound_culling != research::UnsoundCulling::None) {
     throw InputError(
         "PairDetector: normal cones cull self-collision tests only; use Culling::None between "
         "two meshes");
   }
-  if (o.verify) {
+  if (o.research.verify) {
     throw InputError(
         "PairDetector: verify compares culled and unculled self traversals; it has "
         "nothing to verify between two meshes");
+  }
+  if (o.research.optimal_cones) {
+    throw InputError(
+        "PairDetector: optimal cones serve self-collision culling only; it computes no cones "
+        "between two meshes");
   }
   if (o.reuse_distance != 0.0) {
     throw InputError(fmt::format("PairDetector: reuse_distance is not supported (got {}); use 0",

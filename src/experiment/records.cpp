@@ -110,23 +110,34 @@ std::string num(double v) {
 }  // namespace
 
 // The paper's tables spell the policies in capitals (PROVOT, PROPOSED, ...).
-std::string policy_name(ConePolicy p) {
-  std::string s(to_string(p));
+std::string policy_name(ConeRule p) {
+  std::string s(research::to_string(p));
   std::transform(s.begin(), s.end(), s.begin(),
                  [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
   return s;
 }
-std::string culling_name(Culling c) {
-  return std::string(to_string(c));
+std::string policy_name(ConePolicy p) {
+  DetectOptions o;
+  o.policy = p;
+  return policy_name(research::cone_rule(o));
+}
+std::string culling_name(CullingRule c) {
+  return std::string(research::to_string(c));
 }
 std::string build_name(BvhBuild b) {
   return std::string(to_string(b));
 }
 ConePolicy parse_policy(const std::string& s, const std::string& option) {
-  return parse_cone_policy(s, option);
+  const ConeRule rule = research::parse_cone_rule(s, option);
+  if (rule == ConeRule::Optimal) {
+    throw InputError(option + ": OPTIMAL is for spread angles only (see --optimal-every)");
+  }
+  DetectOptions o;
+  research::set_cone_rule(o, rule);
+  return o.policy;
 }
-Culling parse_culling(const std::string& s, const std::string& option) {
-  return clothcd::parse_culling(s, option);
+CullingRule parse_culling(const std::string& s, const std::string& option) {
+  return research::parse_culling_rule(s, option);
 }
 BvhBuild parse_build(const std::string& s, const std::string& option) {
   return parse_bvh_build(s, option);

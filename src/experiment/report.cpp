@@ -95,8 +95,8 @@ std::vector<ConfigKey> config_order(const ExperimentOptions& opt) {
   std::vector<ConfigKey> keys;
   for (BvhBuild b : opt.builds) {
     keys.push_back({build_name(b), "none", "-"});
-    for (Culling c : opt.cullings) {
-      if (c == Culling::None) continue;
+    for (CullingRule c : opt.cullings) {
+      if (c == CullingRule::None) continue;
       for (ConePolicy p : opt.policies)
         keys.push_back({build_name(b), culling_name(c), policy_name(p)});
     }
@@ -226,9 +226,9 @@ std::string table1(const std::vector<SceneData>& data, const ExperimentOptions& 
 
   s += "### Ours: reduction of triangle pair tests vs PROVOT, per rule (paper: +25.5% on "
        "average)\n\n| scene | triangles | build |";
-  std::vector<std::pair<Culling, ConePolicy>> cols;
-  for (Culling c : opt.cullings) {
-    if (c == Culling::None) continue;
+  std::vector<std::pair<CullingRule, ConePolicy>> cols;
+  for (CullingRule c : opt.cullings) {
+    if (c == CullingRule::None) continue;
     for (ConePolicy p : opt.policies) {
       if (p == ConePolicy::Provot) continue;
       cols.emplace_back(c, p);
@@ -593,8 +593,8 @@ std::string summary(const std::vector<SceneData>& data, const ExperimentOptions&
   for (const auto& d : data) {
     const auto tagg = timing_aggs(d);
     for (BvhBuild b : opt.builds) {
-      for (Culling c : opt.cullings) {
-        if (c == Culling::None) continue;
+      for (CullingRule c : opt.cullings) {
+        if (c == CullingRule::None) continue;
         const std::string bn = build_name(b), cn = culling_name(c);
         auto timed = [&](int t) -> std::string {
           const auto it = tagg.find({bn, cn, "PROPOSED", t});

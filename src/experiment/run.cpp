@@ -48,7 +48,7 @@ std::size_t count_missing(const std::vector<T>& a, const std::vector<T>& b, Key 
 auto vf_key = [](const VertexFaceCollision& c) { return std::pair(c.vertex, c.face); };
 auto ee_key = [](const EdgeEdgeCollision& c) { return std::pair(c.edge_a, c.edge_b); };
 
-StepRow make_row(const Sequence& seq, BvhBuild build, int step, Culling c, const std::string& p,
+StepRow make_row(const Sequence& seq, BvhBuild build, int step, CullingRule c, const std::string& p,
                  const DetectResult& r, const DetectResult& ref) {
   const DetectStats& s = r.stats;
   StepRow row;
@@ -114,20 +114,25 @@ std::vector<SpreadRow> spreads(const Sequence& seq, BvhBuild build, int step, Bv
                                const std::vector<ConePolicy>& policies, bool optimal,
                                const std::vector<Eigen::Vector3d>& v0,
                                const std::vector<Eigen::Vector3d>& v1, int node) {
-  std::vector<ConePolicy> all = policies;
-  if (optimal) all.insert(all.begin(), ConePolicy::Optimal);  // first: its domain is needed
+  std::vector<ConeRule> all;
+  if (optimal) all.push_back(ConeRule::Optimal);  // first: its domain is needed
+  for (ConePolicy p : policies) {
+    DetectOptions o;
+    o.policy = p;
+    all.push_back(research::cone_rule(o));
+  }
   std::vector<char> domain;
   std::vector<SpreadRow> out;
-  for (ConePolicy p : all) {
+  for (ConeRule p : all) {
     RefitOptions ro;
-    ro.policy = p;
+    research::set_cone_rule(ro, p);
     const auto t = std::chrono::steady_clock::now();
     bvh.refit(v0, v1, ro);
     const double ms =
         1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
     const auto& cones = bvh.cones();
     const auto& nodes = bvh.nodes();
-    if (p == ConePolicy::Optimal) {
+    if (p == ConeRule::Optimal) {
       domain.assign(nodes.size(), 0);
       for (std::size_t i = 0; i < nodes.size(); ++i)
         domain[i] = !nodes[i].is_leaf() && !cones[i].saturated();
@@ -171,13 +176,13 @@ double load1() {
   return v;
 }
 
-TimingRow timing_row(const Sequence& seq, BvhBuild build, int step, Culling c, ConePolicy p,
+TimingRow timing_row(const Sequence& seq, BvhBuild build, int step, CullingRule c, ConePolicy p,
                      int threads, int repeat, double load, const DetectStats& s) {
   TimingRow row;
   row.scene = seq.name;
   row.build = build_name(build);
   row.culling = culling_name(c);
-  row.policy = c == Culling::None ? "-" : policy_name(p);
+  row.policy = c == CullingRule::None ? "-" : policy_name(p);
   row.step = step;
   row.threads = threads;
   row.repeat = repeat;
@@ -192,9 +197,9 @@ TimingRow timing_row(const Sequence& seq, BvhBuild build, int step, Culling c, C
 std::vector<TimingRow> time_step(const Sequence& seq, BvhBuild build, int step,
                                  const ExperimentOptions& opt, SelfDetector& det,
                                  const Positions& x0, const Positions& x1) {
-  std::vector<std::pair<ConePolicy, Culling>> cfgs{{ConePolicy::Provot, Culling::None}};
-  for (Culling c : opt.timing_cullings) {
-    if (c == Culling::None) continue;
+  std::vector<std::pair<ConePolicy, CullingRule>> cfgs{{ConePolicy::Provot, CullingRule::None}};
+  for (CullingRule c : opt.timing_cullings) {
+    if (c == CullingRule::None) continue;
     for (ConePolicy p : opt.policies)
       cfgs.emplace_back(p, c);
   }
@@ -213,7 +218,7 @@ std::vector<TimingRow> time_step(const Sequence& seq, BvhBuild build, int step,
         DetectOptions o;
         o.build = build;
         o.policy = p;
-        o.culling = c;
+        research::set_culling_rule(o, c);
         det.set_options(o);
         const DetectResult r = det.detect(x0, x1);
         out.push_back(timing_row(seq, build, step, c, p, threads, rep, load, r.stats));
@@ -228,13 +233,6 @@ std::vector<TimingRow> time_step(const Sequence& seq, BvhBuild build, int step,
 void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
                   const std::function<void(const Progress&)>& on_progress, int done_before,
                   int total) {
-  for (ConePolicy p : opt.policies) {
-    if (p == ConePolicy::Optimal) {
-      throw InputError(
-          "OPTIMAL is measured for the spread angles only (--optimal-every), not as "
-          "a detection policy");
-    }
-  }
   const fs::path dir = opt.out / "runs" / seq.name;
   fs::create_directories(dir);
   int done = done_before;
@@ -286,10 +284,10 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
     };
 
     for (int step = 0; step < seq.steps(); step += every) {
-      std::vector<std::pair<ConePolicy, Culling>> todo;
+      std::vector<std::pair<ConePolicy, CullingRule>> todo;
       for (ConePolicy p : opt.policies) {
-        for (Culling c : opt.cullings) {
-          if (c == Culling::None) continue;
+        for (CullingRule c : opt.cullings) {
+          if (c == CullingRule::None) continue;
           if (!have.contains({step, culling_name(c), policy_name(p)})) todo.emplace_back(p, c);
         }
       }
@@ -320,12 +318,12 @@ void run_sequence(const Sequence& seq, const ExperimentOptions& opt,
         det->set_options(o);
         const DetectResult ref = det->detect(x0, x1);
         if (need_none) {
-          rows.push_back(make_row(seq, build, step, Culling::None, "-", ref, ref));
+          rows.push_back(make_row(seq, build, step, CullingRule::None, "-", ref, ref));
           have.emplace(step, "none", "-");
         }
         for (const auto& [p, c] : todo) {
           o.policy = p;
-          o.culling = c;
+          research::set_culling_rule(o, c);
           det->set_options(o);
           const DetectResult r = det->detect(x0, x1);
           rows.push_back(make_row(seq, build, step, c, policy_name(p), r, ref));

@@ -19,6 +19,7 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/oracle.hpp"
 #include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/names.hpp"
 
 namespace clothcd {
 namespace {
@@ -280,10 +281,11 @@ TEST(DetectApi, DeterministicOnOneTwoAndFourThreads) {
   const ProceduralScene s = crumpled_sheet(16, 5);
   const Mesh a = sheet(10);
   const Mesh b = ball(3, 0.18, {0.47, 0.52, 0.2}, {0.5, 0.49, 0.05});
-  for (Culling culling : {Culling::None, Culling::Cone, Culling::Sound}) {
+  for (research::CullingRule culling :
+       {research::CullingRule::None, research::CullingRule::Cone, research::CullingRule::Sound}) {
     DetectOptions o;
     o.build = BvhBuild::Patch;
-    o.culling = culling;
+    research::set_culling_rule(o, culling);
     std::optional<DetectResult> first;
     std::optional<PairDetectResult> first_pair;
     for (int threads : {1, 2, 4}) {
@@ -293,6 +295,7 @@ TEST(DetectApi, DeterministicOnOneTwoAndFourThreads) {
       const DetectResult r = det.detect(s.v_t0, s.v_t1);
       DetectOptions po = o;
       po.culling = Culling::None;  // the two-mesh detector refuses cones
+      po.research = {};
       PairDetector pd(a.faces, a.nv(), a.v0, b.faces, b.nv(), b.v0, po);
       const PairDetectResult pr = pd.detect(a.v0, a.v1, b.v0, b.v1);
       if (!first) {

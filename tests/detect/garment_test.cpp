@@ -14,6 +14,7 @@
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/sewing.hpp"
+#include "clothcd/research/options.hpp"
 #include "support/data.hpp"
 
 namespace clothcd {
@@ -71,16 +72,17 @@ TEST(Garments, DressPatchConnectedAndSoundCullsHalfOfCone) {
       SCOPED_TRACE(::testing::Message() << "build " << int(build) << " policy " << k);
       o.policy = policies[k];
       o.culling = Culling::Sound;
-      o.verify = true;
+      o.research = {};  // the cone rule of the previous policy off
+      o.research.verify = true;
       det.set_options(o);
       const DetectResult sound = det.detect(g.p0, g.p1);
-      ASSERT_TRUE(sound.verified);
-      EXPECT_TRUE(sound.missed_vf.empty());
-      EXPECT_TRUE(sound.missed_ee.empty());
+      ASSERT_TRUE(sound.verification.ran);
+      EXPECT_TRUE(sound.verification.missed_vf.empty());
+      EXPECT_TRUE(sound.verification.missed_ee.empty());
       EXPECT_EQ(sound.vf, none.vf);
       EXPECT_EQ(sound.ee, none.ee);
-      o.culling = Culling::Cone;
-      o.verify = false;
+      o.research.unsound_culling = research::UnsoundCulling::Cone;
+      o.research.verify = false;
       det.set_options(o);
       const DetectResult cone = det.detect(g.p0, g.p1);
       cone_best[k] = std::max(cone_best[k], culled_share(cone, none));
@@ -103,14 +105,15 @@ TEST(Garments, MultilayerPatchConnectedAndSoundExact) {
   o.build = BvhBuild::Patch;
   o.policy = ConePolicy::Proposed;
   o.culling = Culling::Sound;
-  o.verify = true;
+  o.research.verify = true;
   SelfDetector det(g.sewn.faces, g.sewn.num_vertices(), g.p0, o);
   const DetectResult r = det.detect(g.p0, g.p1);
   EXPECT_GE(r.stats.connected_share(), 0.99);
-  ASSERT_TRUE(r.verified);
-  EXPECT_GT(r.vf.size() + r.ee.size() + r.missed_vf.size() + r.missed_ee.size(), 0u);
-  EXPECT_TRUE(r.missed_vf.empty());
-  EXPECT_TRUE(r.missed_ee.empty());
+  const research::Verification& v = r.verification;
+  ASSERT_TRUE(v.ran);
+  EXPECT_GT(r.vf.size() + r.ee.size() + v.missed_vf.size() + v.missed_ee.size(), 0u);
+  EXPECT_TRUE(v.missed_vf.empty());
+  EXPECT_TRUE(v.missed_ee.empty());
 }
 
 // The simulator's settings on the dress: a CCD thickness, pairs kept for a proximity query at a
@@ -139,12 +142,12 @@ TEST(Garments, DressSoundWithThicknessAndReuseExact) {
     o.culling = Culling::Sound;
     o.policy = policy;
     o.reuse_distance = reuse;
-    o.verify = true;
+    o.research.verify = true;
     SelfDetector det(g.sewn.faces, g.sewn.num_vertices(), g.p0, o);
     const DetectResult r = det.detect(g.p0, g.p1);
-    ASSERT_TRUE(r.verified);
-    EXPECT_TRUE(r.missed_vf.empty());
-    EXPECT_TRUE(r.missed_ee.empty());
+    ASSERT_TRUE(r.verification.ran);
+    EXPECT_TRUE(r.verification.missed_vf.empty());
+    EXPECT_TRUE(r.verification.missed_ee.empty());
     culled += r.stats.nodes_culled;
     for (const Positions* at : std::array<const Positions*, 2>{&g.p1, &shifted}) {
       static_cast<void>(det.detect(g.p0, g.p1));

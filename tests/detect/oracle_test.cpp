@@ -1,5 +1,6 @@
 // The detector against the brute-force oracle on procedural scenes: exact collision sets for the
-// sound modes in every cone policy and both BVH builds; the unsound modes miss where expected.
+// sound modes in every cone policy and both BVH builds; the unsound research rules miss where
+// expected, and the research verification reports exactly those misses.
 
 #include <gtest/gtest.h>
 
@@ -8,6 +9,7 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/oracle.hpp"
 #include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/names.hpp"
 
 namespace clothcd {
 namespace {
@@ -32,8 +34,9 @@ std::vector<ProceduralScene> scenes() {
   return s;
 }
 
-constexpr ConePolicy kPolicies[] = {ConePolicy::Provot, ConePolicy::Proposed, ConePolicy::Exact,
-                                    ConePolicy::Optimal};
+constexpr research::ConeRule kPolicies[] = {research::ConeRule::Provot,
+                                            research::ConeRule::Proposed, research::ConeRule::Exact,
+                                            research::ConeRule::Optimal};
 constexpr BvhBuild kBuilds[] = {BvhBuild::Spatial, BvhBuild::Patch};
 
 DetectResult run(const ProceduralScene& s, DetectOptions o) {
@@ -47,11 +50,11 @@ TEST(DetectOracle, NoneAndSoundEqualBruteForce) {
     const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1);
     EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u) << s.name << ": the motion must collide";
     for (BvhBuild build : kBuilds) {
-      for (ConePolicy policy : kPolicies) {
+      for (research::ConeRule policy : kPolicies) {
         for (Culling culling : {Culling::None, Culling::Sound}) {
           DetectOptions o;
           o.build = build;
-          o.policy = policy;
+          research::set_cone_rule(o, policy);
           o.culling = culling;
           const DetectResult r = run(s, o);
           SCOPED_TRACE(::testing::Message() << s.name << " build " << int(build) << " policy "
@@ -74,31 +77,56 @@ struct Misses {
   std::size_t found_by_none = 0;
 };
 
-Misses misses(const ProceduralScene& s, Culling culling, ConePolicy policy, BvhBuild build) {
+Misses misses(const ProceduralScene& s, research::CullingRule culling, research::ConeRule policy,
+              BvhBuild build) {
   DetectOptions o;
-  o.culling = culling;
-  o.policy = policy;
+  research::set_culling_rule(o, culling);
+  research::set_cone_rule(o, policy);
   o.build = build;
-  o.verify = true;
+  o.research.verify = true;
   const DetectResult r = run(s, o);
-  EXPECT_TRUE(r.verified);
+  const research::Verification& v = r.verification;
+  EXPECT_TRUE(v.ran);
   o.culling = Culling::None;
-  o.verify = false;
+  o.research = {};
   const DetectResult all = run(s, o);
-  EXPECT_EQ(r.missed_vf.size() + r.vf.size(), all.vf.size());
-  EXPECT_EQ(r.missed_ee.size() + r.ee.size(), all.ee.size());
-  return {r.missed_vf.size() + r.missed_ee.size(), all.vf.size() + all.ee.size()};
+  EXPECT_EQ(v.missed_vf.size() + r.vf.size(), all.vf.size());
+  EXPECT_EQ(v.missed_ee.size() + r.ee.size(), all.ee.size());
+  return {v.missed_vf.size() + v.missed_ee.size(), all.vf.size() + all.ee.size()};
+}
+
+// The research options directly, as a measurement sets them: an unsound rule overrides the
+// culling, and verify lists what it missed.
+TEST(DetectOracle, ResearchOptionsOverrideTheCullingAndVerifyListsTheMisses) {
+  const auto s = winding_strip(72, 3);
+  DetectOptions o;
+  o.build = BvhBuild::Patch;
+  o.culling = Culling::Sound;
+  o.research.unsound_culling = research::UnsoundCulling::Gated;
+  o.research.verify = true;
+  EXPECT_EQ(research::culling_rule(o), research::CullingRule::Gated);
+  const DetectResult gated = run(s, o);
+  ASSERT_TRUE(gated.verification.ran);
+  EXPECT_GT(gated.verification.missed_vf.size() + gated.verification.missed_ee.size(), 0u);
+  EXPECT_GT(gated.verification.unculled_triangle_pairs, gated.stats.triangle_pairs);
+  o.research.unsound_culling = research::UnsoundCulling::None;
+  const DetectResult sound = run(s, o);
+  ASSERT_TRUE(sound.verification.ran);
+  EXPECT_TRUE(sound.verification.missed_vf.empty());
+  EXPECT_TRUE(sound.verification.missed_ee.empty());
+  o.culling = Culling::None;
+  EXPECT_FALSE(run(s, o).verification.ran);  // nothing culled, nothing to verify
 }
 
 TEST(DetectOracle, ConeMissesStackedSheetsGatedDoesNot) {
   const auto s = stacked_sheets(10);
   for (BvhBuild build : kBuilds) {
-    for (ConePolicy policy : kPolicies) {
-      const Misses cone = misses(s, Culling::Cone, policy, build);
+    for (research::ConeRule policy : kPolicies) {
+      const Misses cone = misses(s, research::CullingRule::Cone, policy, build);
       EXPECT_GT(cone.found_by_none, 0u);
       EXPECT_GT(cone.missed, 0u) << "policy " << int(policy) << " build " << int(build);
-      EXPECT_EQ(misses(s, Culling::Gated, policy, build).missed, 0u);
-      EXPECT_EQ(misses(s, Culling::Sound, policy, build).missed, 0u);
+      EXPECT_EQ(misses(s, research::CullingRule::Gated, policy, build).missed, 0u);
+      EXPECT_EQ(misses(s, research::CullingRule::Sound, policy, build).missed, 0u);
     }
   }
 }
@@ -106,11 +134,11 @@ TEST(DetectOracle, ConeMissesStackedSheetsGatedDoesNot) {
 TEST(DetectOracle, GatedMissesWindingStripSoundDoesNot) {
   const auto s = winding_strip(72, 3);
   for (BvhBuild build : kBuilds) {
-    for (ConePolicy policy : kPolicies) {
+    for (research::ConeRule policy : kPolicies) {
       SCOPED_TRACE(::testing::Message() << "policy " << int(policy) << " build " << int(build));
-      EXPECT_GT(misses(s, Culling::Cone, policy, build).missed, 0u);
-      EXPECT_GT(misses(s, Culling::Gated, policy, build).missed, 0u);
-      EXPECT_EQ(misses(s, Culling::Sound, policy, build).missed, 0u);
+      EXPECT_GT(misses(s, research::CullingRule::Cone, policy, build).missed, 0u);
+      EXPECT_GT(misses(s, research::CullingRule::Gated, policy, build).missed, 0u);
+      EXPECT_EQ(misses(s, research::CullingRule::Sound, policy, build).missed, 0u);
     }
   }
 }

@@ -192,7 +192,10 @@ TEST(PairDetector, RefusesOptionsItCannotHonour) {
   o.culling = Culling::Sound;
   EXPECT_THROW(make(o), InputError);
   o = {};
-  o.verify = true;
+  o.research.verify = true;
+  EXPECT_THROW(make(o), InputError);
+  o = {};
+  o.research.optimal_cones = true;
   EXPECT_THROW(make(o), InputError);
   o = {};
   o.reuse_distance = 0.001;
@@ -205,7 +208,7 @@ TEST(PairDetector, RefusesOptionsItCannotHonour) {
   EXPECT_THROW(make(o), InputError);
   PairDetector det(s.a.faces, s.a.nv(), s.a.v0, s.b.faces, s.b.nv(), s.b.v0);
   o = {};
-  o.culling = Culling::Cone;
+  o.research.unsound_culling = research::UnsoundCulling::Cone;
   EXPECT_THROW(det.set_options(o), InputError);
   EXPECT_THROW(det.set_active_vertices(std::vector<int>{s.a.nv()}), InputError);
   EXPECT_THROW((void)det.proximity(s.a.v0, s.b.v0, -1.0), InputError);

@@ -185,7 +185,7 @@ TEST(ProximityReuse, OffWhereItCannotHold) {
   {
     SCOPED_TRACE("the unsound cone rule may cull close pairs");
     DetectOptions cone = o;
-    cone.culling = Culling::Cone;
+    cone.research.unsound_culling = research::UnsoundCulling::Cone;
     SelfDetector det(s.faces, s.num_vertices, s.v_t0, cone);
     static_cast<void>(det.detect(s.v_t0, end));
     const ProximityResult r = det.proximity(end, kKept);

@@ -184,12 +184,9 @@ TEST(Experiment, ResumeRunsOnlyMissingConfigurations) {
     ASSERT_NE(it, second.end());
     EXPECT_EQ(it->ms_narrow, r.ms_narrow);
   }
-  EXPECT_THROW(
-      {
-        opt.policies = {ConePolicy::Optimal};
-        run_sequence(seq, opt);
-      },
-      InputError);
+  // OPTIMAL is measured for the spread angles only, never as a detection policy.
+  EXPECT_THROW((void)parse_policy("optimal", "--policies"), InputError);
+  EXPECT_EQ(parse_policy("PROPOSED", "--policies"), ConePolicy::Proposed);
   fs::remove_all(opt.out);
 }
 

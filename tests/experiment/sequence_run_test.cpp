@@ -100,7 +100,7 @@ TEST(ExperimentSequence, TimingPassRepeatsEveryConfigurationPerThreadCount) {
   opt.timing_every = 3;  // calls 0 and 3
   opt.timing_repeats = 2;
   opt.timing_threads = {1, 2};
-  opt.timing_cullings = {Culling::Sound};
+  opt.timing_cullings = {CullingRule::Sound};
   run_sequence(seq, opt);
   const fs::path file = opt.out / "runs" / seq.name / "spatial.timing.csv";
   const auto rows = read_timing_rows(file);

@@ -30,7 +30,6 @@ enum class ConePolicy {
   Provot,    ///< C_Tang leaves, M_Provot merges (the paper's PROVOT)
   Proposed,  ///< C_Proposed leaves, M_Proposed merges (the paper's PROPOSED)
   Exact,     ///< exact leaf caps, M_Proposed merges (ours)
-  Optimal,   ///< optimal cone of every descendant leaf's control directions (reference)
 };
 
 /// One node: 64 bytes. Leaves hold exactly one triangle, prim_ids()[first].
@@ -62,6 +61,10 @@ struct RefitOptions {
   double thickness = 0.0;  ///< boxes grow by thickness / 2 on every side (rounded outwards)
   bool cones = true;       ///< compute the normal cones (box-only traversal skips them)
   ConePolicy policy = ConePolicy::Proposed;
+  /// Research reference, not for simulation: instead of `policy`, every node gets the optimal
+  /// cone of its descendant leaves' normal control directions (exact leaf caps). Slow: a node
+  /// costs time linear in its triangles (clothcd/research/options.hpp).
+  bool optimal_cones = false;
   bool operator==(const RefitOptions&) const = default;
 };
 
@@ -139,7 +142,7 @@ class Bvh {
   std::vector<int> contour_offsets_;  // CSR per node
   std::vector<int> contour_vertices_;
   std::vector<NormalCone> cones_;
-  // Unit Bernstein control directions of each leaf, by prim position (Optimal policy only).
+  // Unit Bernstein control directions of each leaf, by prim position (optimal_cones only).
   std::vector<Eigen::Vector3d> control_dirs_;
   std::vector<std::uint8_t> degenerate_;
   // What the last refit_changed() fitted (cleared by any other refit).

@@ -127,8 +127,9 @@ class PairDetector {
  public:
   /// Builds both topologies and box-only BVHs (split on the references). Throws InputError on
   /// bad faces, a reference of the wrong size, or options it cannot honour between two meshes:
-  /// a culling other than Culling::None (cones cull self tests only), verify, reuse_distance
-  /// other than 0, linked_vertices (they join vertices of one mesh), a negative thickness.
+  /// a culling other than Culling::None (cones cull self tests only), research options other than
+  /// their defaults, reuse_distance other than 0, linked_vertices (they join vertices of one
+  /// mesh), a negative thickness.
   PairDetector(std::vector<Face> faces_a, int num_vertices_a, const Positions& reference_a,
                std::vector<Face> faces_b, int num_vertices_b, const Positions& reference_b,
                const DetectOptions& options = {});

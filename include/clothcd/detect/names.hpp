@@ -1,13 +1,15 @@
 #pragma once
 /// @file
-/// The names of the detector's options, as the command-line tool, the Python module and the
-/// experiment files spell them: one mapping, both ways.
+/// The names of the detector's options, as the command-line tool, the Python module, the scene
+/// files and the experiment files spell them: one mapping, both ways.
 ///
-///   ConePolicy: provot, proposed, exact, optimal
-///   Culling:    none, cone, gated, sound
+///   ConePolicy: provot, proposed, exact
+///   Culling:    none, sound
 ///   BvhBuild:   spatial, patch
 ///
 /// Names are lower case; parsing ignores case, so the paper's PROVOT and PROPOSED are accepted.
+/// The research settings (the unsound rules cone and gated, the optimal cones) have their names in
+/// clothcd/research/names.hpp.
 
 #include <string_view>
 

@@ -7,18 +7,18 @@
 #include <vector>
 
 #include "clothcd/bvh/bvh.hpp"
+#include "clothcd/detect/collisions.hpp"
 #include "clothcd/mesh/topology.hpp"
+#include "clothcd/research/options.hpp"
 
 namespace clothcd {
 
 /// When the self traversal may skip a node's self-collision test (docs/detect.md).
 enum class Culling {
   None,   ///< boxes only
-  Cone,   ///< the paper's literal rule: cone below pi/2 (unsound)
-  Gated,  ///< cone below pi/2 on edge-connected nodes only (still unsound: the winding strip)
-  Sound,  ///< gated, on disk nodes, plus the contour test (and, with a thickness or a reuse
-          ///< distance, clearances that keep culled features out of reach): finds exactly what
-          ///< None finds
+  Sound,  ///< a node whose triangles form a disk skips its self test when its normal cone is
+          ///< below pi/2 and its contour test passes (and, with a thickness or a reuse
+          ///< distance, clearances keep its features out of reach): finds exactly what None finds
 };
 
 struct DetectOptions {
@@ -52,31 +52,13 @@ struct DetectOptions {
   /// near the vertices whose position in v differs from theirs at t1 (all of them when over a
   /// quarter do).
   double reuse_distance = 0.0;
-  /// Also run the unculled traversal and report what the culled one missed.
-  bool verify = false;
   /// Optional vertex pairs that count as one point (the two sides of a stitched seam): VF and EE
   /// pairs joining them are not tested, like pairs that share a vertex. Any order; duplicates
   /// allowed.
   std::vector<std::pair<int, int>> linked_vertices;
-};
-
-/// Vertex `vertex` hits face `face` (vertex ids `face_vertices`) at time `toi` in [0, 1].
-struct VertexFaceCollision {
-  int vertex = -1;
-  int face = -1;
-  Face face_vertices{};
-  double toi = 1.0;
-  friend bool operator==(const VertexFaceCollision&, const VertexFaceCollision&) = default;
-};
-
-/// Edge `edge_a` < `edge_b` (Topology edge ids) touch at time `toi`.
-struct EdgeEdgeCollision {
-  int edge_a = -1;
-  int edge_b = -1;
-  Edge edge_a_vertices{};
-  Edge edge_b_vertices{};
-  double toi = 1.0;
-  friend bool operator==(const EdgeEdgeCollision&, const EdgeEdgeCollision&) = default;
+  /// For measuring the paper's rules; a simulator leaves it at its default (see
+  /// clothcd/research/options.hpp: unsound culling rules, optimal cones, verification).
+  research::Options research;
 };
 
 /// Counters and times of one detection call (times in seconds).
@@ -114,11 +96,8 @@ struct DetectResult {
   std::vector<VertexFaceCollision> vf;  ///< sorted by (vertex, face)
   std::vector<EdgeEdgeCollision> ee;    ///< sorted by (edge_a, edge_b)
   DetectStats stats;
-  /// With DetectOptions::verify: collisions the unculled traversal finds and this one missed.
-  bool verified = false;
-  std::vector<VertexFaceCollision> missed_vf;
-  std::vector<EdgeEdgeCollision> missed_ee;
-  std::uint64_t unculled_triangle_pairs = 0;  ///< triangle pairs of the unculled traversal
+  /// What the unculled detection found and this one missed (DetectOptions::research.verify).
+  research::Verification verification;
 };
 
 }  // namespace clothcd

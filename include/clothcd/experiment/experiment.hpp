@@ -13,23 +13,31 @@
 
 #include "clothcd/detect/types.hpp"
 #include "clothcd/experiment/sequence.hpp"
+#include "clothcd/research/names.hpp"
 
 namespace clothcd::experiment {
 
-[[nodiscard]] std::string policy_name(ConePolicy p);  ///< PROVOT, PROPOSED, EXACT, OPTIMAL
-[[nodiscard]] std::string culling_name(Culling c);    ///< none, cone, gated, sound
-[[nodiscard]] std::string build_name(BvhBuild b);     ///< spatial, patch
+/// The rules of the experiment: every culling rule and cone computation the paper compares.
+using research::ConeRule;
+using research::CullingRule;
+
+[[nodiscard]] std::string policy_name(ConePolicy p);    ///< PROVOT, PROPOSED, EXACT
+[[nodiscard]] std::string policy_name(ConeRule p);      ///< ... and OPTIMAL
+[[nodiscard]] std::string culling_name(CullingRule c);  ///< none, cone, gated, sound
+[[nodiscard]] std::string build_name(BvhBuild b);       ///< spatial, patch
 /// Case-insensitive parsers; throw InputError naming `option` and the accepted values.
+/// parse_policy takes the detection policies: OPTIMAL (measured for the spread angles only, see
+/// ExperimentOptions::optimal_every) is refused with a message that says so.
 [[nodiscard]] ConePolicy parse_policy(const std::string& s, const std::string& option);
-[[nodiscard]] Culling parse_culling(const std::string& s, const std::string& option);
+[[nodiscard]] CullingRule parse_culling(const std::string& s, const std::string& option);
 [[nodiscard]] BvhBuild parse_build(const std::string& s, const std::string& option);
 
 struct ExperimentOptions {
   std::filesystem::path out;
-  /// Policies run with every culling rule (OPTIMAL is not allowed here: its refit is slow and it
-  /// is measured for the spread angles only).
+  /// Policies run with every culling rule (not OPTIMAL: its refit is slow and it is measured for
+  /// the spread angles only).
   std::vector<ConePolicy> policies{ConePolicy::Provot, ConePolicy::Proposed, ConePolicy::Exact};
-  std::vector<Culling> cullings{Culling::Cone, Culling::Gated, Culling::Sound};
+  std::vector<CullingRule> cullings{CullingRule::Cone, CullingRule::Gated, CullingRule::Sound};
   std::vector<BvhBuild> builds{BvhBuild::Spatial, BvhBuild::Patch};
   /// OPTIMAL cones are computed on the run calls 0, K, 2K, ... (see Sequence::every; 0: never).
   int optimal_every = 10;
@@ -44,7 +52,8 @@ struct ExperimentOptions {
   int timing_every = 0;
   int timing_repeats = 3;
   std::vector<int> timing_threads{1, 2};
-  std::vector<Culling> timing_cullings{Culling::Cone, Culling::Gated, Culling::Sound};
+  std::vector<CullingRule> timing_cullings{CullingRule::Cone, CullingRule::Gated,
+                                           CullingRule::Sound};
   /// Lines written at the top of every report (commit, machine, date, load, ...); see stamp().
   std::string stamp;
 };
