@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian packages clothcd needs; does nothing when they are all present.
 # Usage: scripts/setup.sh [demo|test|full]
-#   demo: the library and the command-line tool; test (default): also the test suite's needs
-#   (the Python module and its tests included);
-#   full: also the benchmarks and the clang sanitizer and fuzzing tree (test.sh --full).
+#   demo: the library and the command-line tool; test (default): also the test suite's needs;
+#   full: also the Python module and its tests, the benchmarks and the clang sanitizer and fuzzing
+#   tree (test.sh --full).
 set -euo pipefail
 
 profile=${1:-test}
@@ -14,10 +14,10 @@ packages=(
 case "$profile" in
   demo) ;;
   test | full)
-    packages+=(libgtest-dev libgmock-dev libgmp-dev clang-format python3-matplotlib
-      pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-meshio)
+    packages+=(libgtest-dev libgmock-dev libgmp-dev clang-format python3-matplotlib)
     if [ "$profile" = full ]; then
-      packages+=(libbenchmark-dev clang libclang-rt-14-dev)
+      packages+=(pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
+        python3-meshio libbenchmark-dev clang libclang-rt-14-dev)
     fi
     ;;
   *) echo "setup.sh: unknown profile '$profile' (expected demo, test or full)" >&2; exit 2 ;;
