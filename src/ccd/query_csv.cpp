@@ -179,7 +179,7 @@ EdgeEdgeQuery to_edge_edge(const CsvQuery& q) {
 
 CcdResult run_query(QueryKind kind, const CsvQuery& q, const CcdOptions& opt) {
   return kind == QueryKind::VertexFace ? vertex_face_ccd(to_vertex_face(q), opt)
-                                        : edge_edge_ccd(to_edge_edge(q), opt);
+                                       : edge_edge_ccd(to_edge_edge(q), opt);
 }
 
 }  // namespace clothcd

@@ -14,7 +14,7 @@ namespace {
 
 bool exact(QueryKind kind, const CsvQuery& q, double t_max = 1.0) {
   return kind == QueryKind::VertexFace ? test::exact_vertex_face_contact(to_vertex_face(q), t_max)
-                                        : test::exact_edge_edge_contact(to_edge_edge(q), t_max);
+                                       : test::exact_edge_edge_contact(to_edge_edge(q), t_max);
 }
 
 std::vector<QueryFile> load(const std::filesystem::path& root) {
