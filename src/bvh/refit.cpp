@@ -9,7 +9,6 @@
 
 #include "clothcd/bvh/bvh.hpp"
 #include "core/moved_vertices.hpp"
-#include "core/ulp.hpp"
 
 namespace clothcd {
 namespace {
@@ -30,14 +29,6 @@ LeafConePolicy leaf_policy(ConePolicy p) {
       return LeafConePolicy::Exact;
   }
   return LeafConePolicy::Exact;
-}
-
-void inflate(BvhNode& n, double margin) {
-  if (margin <= 0) return;
-  for (int k = 0; k < 3; ++k) {
-    n.lo[k] = detail::next_down(n.lo[k] - margin);
-    n.hi[k] = detail::next_up(n.hi[k] + margin);
-  }
 }
 
 void set_box(BvhNode& n, std::initializer_list<const Eigen::Vector3d*> pts) {
@@ -150,7 +141,7 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
     const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
     const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
     set_box(n, {&a0, &b0, &c0, &a1, &b1, &c1});
-    inflate(n, margin);
+    inflate(n.lo, n.hi, margin);
     if (!options.cones) return;
     cones_[i] = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, lp);
     if (optimal) {
@@ -178,7 +169,7 @@ void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options)
     const Face& t = faces[prim_ids_[n.first]];
     const Eigen::Vector3d &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
     set_box(n, {&a, &b, &c});
-    inflate(n, margin);
+    inflate(n.lo, n.hi, margin);
     if (!options.cones) return;
     cones_[i] = dcd_leaf_cone(a, b, c);
     if (optimal) {

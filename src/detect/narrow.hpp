@@ -18,55 +18,21 @@
 #include <vector>
 
 #include "ccd/face_bounds.hpp"
+#include "clothcd/bvh/aabb.hpp"
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/types.hpp"
 #include "core/moved_vertices.hpp"
-#include "core/ulp.hpp"
 
 namespace clothcd::detail {
 
 /// Swept box of a feature, stored in float (half the memory traffic of the narrow phase, whose
 /// box tests are memory-bound), rounded outwards so it still contains the double box.
-struct Box {
-  float lo[3], hi[3];
-};
-
-inline float round_down(double x) {
-  const float f = static_cast<float>(x);
-  return f > x ? next_down(f) : f;
-}
-inline float round_up(double x) {
-  const float f = static_cast<float>(x);
-  return f < x ? next_up(f) : f;
-}
+using Box = FeatureBox;
+using clothcd::overlap;
 
 inline Box swept_box(std::initializer_list<const Eigen::Vector3d*> pts, double margin) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (const Eigen::Vector3d* p : pts) {
-    lo = lo.cwiseMin(*p);
-    hi = hi.cwiseMax(*p);
-  }
-  if (margin > 0) {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = next_down(lo[k] - margin);
-      hi[k] = next_up(hi[k] + margin);
-    }
-  }
-  Box b;
-  for (int k = 0; k < 3; ++k) {
-    b.lo[k] = round_down(lo[k]);
-    b.hi[k] = round_up(hi[k]);
-  }
-  return b;
-}
-
-// Non-short-circuit `&`: one branch per test instead of up to six badly predicted ones (the
-// narrow phase's box tests fail about half the time, in no pattern).
-inline bool overlap(const Box& a, const Box& b) {
-  return (a.lo[0] <= b.hi[0]) & (a.lo[1] <= b.hi[1]) & (a.lo[2] <= b.hi[2]) & (b.lo[0] <= a.hi[0]) &
-         (b.lo[1] <= a.hi[1]) & (b.lo[2] <= a.hi[2]);
+  return swept_feature_box(pts, margin);
 }
 
 inline bool share_vertex(const Face& a, const Face& b) {

@@ -14,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "clothcd/bvh/aabb.hpp"
 #include "clothcd/geometry/cone.hpp"
 #include "clothcd/mesh/topology.hpp"
 
@@ -52,8 +53,7 @@ static_assert(sizeof(BvhNode) == 64, "BvhNode must stay one cache line");
 
 /// Box overlap of two nodes (closed boxes).
 [[nodiscard]] inline bool overlap(const BvhNode& a, const BvhNode& b) {
-  return a.lo[0] <= b.hi[0] && b.lo[0] <= a.hi[0] && a.lo[1] <= b.hi[1] && b.lo[1] <= a.hi[1] &&
-         a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
+  return overlap(a.lo, a.hi, b.lo, b.hi);
 }
 
 /// Options of a refit.
