@@ -10,7 +10,7 @@
 
 #include "clothcd/bvh/bvh.hpp"
 
-namespace clothcd {
+namespace clothcd::aabb_test {
 namespace {
 
 TEST(Aabb, OverlapIsClosed) {
@@ -65,4 +65,4 @@ TEST(Aabb, FeatureBoxesContainTheExactGrownBox) {
 }
 
 }  // namespace
-}  // namespace clothcd
+}  // namespace clothcd::aabb_test

@@ -12,7 +12,8 @@
 
 #include "clothcd/detect/procedural.hpp"
 
-namespace clothcd {
+// Helpers in a namespace of their own: the tests of a folder may share one translation unit.
+namespace clothcd::traverse_test {
 namespace {
 
 std::vector<Eigen::Vector3d> points(const Positions& p, const Eigen::Vector3d& shift = {0, 0, 0}) {
@@ -125,4 +126,4 @@ TEST(Traverse, TinyAndEmptyTrees) {
 }
 
 }  // namespace
-}  // namespace clothcd
+}  // namespace clothcd::traverse_test

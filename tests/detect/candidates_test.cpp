@@ -16,7 +16,8 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/procedural.hpp"
 
-namespace clothcd {
+// Helpers in a namespace of their own: the tests of a folder may share one translation unit.
+namespace clothcd::candidates_test {
 namespace {
 
 Eigen::Vector3d row(const Positions& p, int i) {
@@ -118,4 +119,4 @@ TEST(Candidates, PairsSharingAVertexYieldNothingAndOrderDoesNotMatter) {
 }
 
 }  // namespace
-}  // namespace clothcd
+}  // namespace clothcd::candidates_test
