@@ -230,23 +230,21 @@ class Builder {
 
 }  // namespace
 
-Bvh::Bvh(const Topology& topology, std::span<const Eigen::Vector3d> reference, BvhBuild build)
-    : topology_(&topology) {
-  build_tree(reference, build);
-  compute_flags();
+Bvh::Bvh(const Topology& topology, std::span<const Eigen::Vector3d> reference, BvhBuild build) {
+  build_tree(topology, reference, build);
+  compute_flags(topology);
 }
 
 Bvh Bvh::boxes_only(const Topology& topology, std::span<const Eigen::Vector3d> reference,
                     BvhBuild build) {
   Bvh b;
-  b.topology_ = &topology;
-  b.build_tree(reference, build);
+  b.build_tree(topology, reference, build);
   b.contour_offsets_.assign(b.nodes_.size() + 1, 0);  // no node has a contour
   return b;
 }
 
-void Bvh::build_tree(std::span<const Eigen::Vector3d> reference, BvhBuild build) {
-  const Topology& topology = *topology_;
+void Bvh::build_tree(const Topology& topology, std::span<const Eigen::Vector3d> reference,
+                     BvhBuild build) {
   if (static_cast<int>(reference.size()) != topology.num_vertices()) {
     throw InputError(fmt::format("BVH reference shape has {} vertices, the topology {}",
                                  reference.size(), topology.num_vertices()));
@@ -283,6 +281,8 @@ void Bvh::build_tree(std::span<const Eigen::Vector3d> reference, BvhBuild build)
     if (nodes_[i].is_leaf()) leaf_of_face_[prim_ids_[nodes_[i].first]] = i;
   }
   cones_.resize(nodes_.size());
+  faces_ = topology.faces();
+  num_vertices_ = topology.num_vertices();
 }
 
 }  // namespace clothcd

@@ -37,8 +37,7 @@ std::vector<std::uint8_t> Bvh::nodes_holding(std::span<const std::uint8_t> face_
   return out;
 }
 
-void Bvh::compute_flags() {
-  const Topology& topo = *topology_;
+void Bvh::compute_flags(const Topology& topo) {
   const int nn = static_cast<int>(nodes_.size());
   std::vector<int> pos(topo.num_faces());
   for (int i = 0; i < static_cast<int>(prim_ids_.size()); ++i)

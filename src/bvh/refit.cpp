@@ -9,7 +9,6 @@
 
 #include "clothcd/bvh/bvh.hpp"
 #include "core/moved_vertices.hpp"
-#include "core/ulp.hpp"
 
 namespace clothcd {
 namespace {
@@ -30,14 +29,6 @@ LeafConePolicy leaf_policy(ConePolicy p) {
       return LeafConePolicy::Exact;
   }
   return LeafConePolicy::Exact;
-}
-
-void inflate(BvhNode& n, double margin) {
-  if (margin <= 0) return;
-  for (int k = 0; k < 3; ++k) {
-    n.lo[k] = detail::next_down(n.lo[k] - margin);
-    n.hi[k] = detail::next_up(n.hi[k] + margin);
-  }
 }
 
 void set_box(BvhNode& n, std::initializer_list<const Eigen::Vector3d*> pts) {
@@ -125,9 +116,15 @@ void Bvh::refit_changed(std::span<const Eigen::Vector3d> v_t0,
                         std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options) {
   if (changed_options_ != options) forget_changes();
   const auto moved = detail::moved_vertices(changed_t0_, changed_t1_, v_t0, v_t1);
-  refit_nodes(
-      v_t0, v_t1, options,
-      moved ? nodes_holding(topology_->faces_touching(*moved)) : std::vector<std::uint8_t>{});
+  std::vector<std::uint8_t> touched;
+  if (moved) {
+    touched.assign(faces_.size(), 0);
+    for (std::size_t f = 0; f < faces_.size(); ++f) {
+      for (int v : faces_[f])
+        touched[f] |= (*moved)[v];
+    }
+  }
+  refit_nodes(v_t0, v_t1, options, moved ? nodes_holding(touched) : std::vector<std::uint8_t>{});
   changed_options_ = options;
 }
 
@@ -138,13 +135,13 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
   const LeafConePolicy lp =
       options.optimal_cones ? LeafConePolicy::Exact : leaf_policy(options.policy);
   const bool optimal = options.cones && options.optimal_cones;
-  const auto& faces = topology_->faces();
+  const auto& faces = faces_;
   refit_levels(options, nodes, [&](BvhNode& n, int i) {
     const Face& t = faces[prim_ids_[n.first]];
     const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
     const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
     set_box(n, {&a0, &b0, &c0, &a1, &b1, &c1});
-    inflate(n, margin);
+    inflate(n.lo, n.hi, margin);
     if (!options.cones) return;
     cones_[i] = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, lp);
     if (optimal) {
@@ -167,12 +164,12 @@ void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options)
   forget_changes();
   const double margin = 0.5 * options.thickness;
   const bool optimal = options.cones && options.optimal_cones;
-  const auto& faces = topology_->faces();
+  const auto& faces = faces_;
   refit_levels(options, {}, [&](BvhNode& n, int i) {
     const Face& t = faces[prim_ids_[n.first]];
     const Eigen::Vector3d &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
     set_box(n, {&a, &b, &c});
-    inflate(n, margin);
+    inflate(n.lo, n.hi, margin);
     if (!options.cones) return;
     cones_[i] = dcd_leaf_cone(a, b, c);
     if (optimal) {

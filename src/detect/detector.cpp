@@ -296,47 +296,18 @@ struct SelfDetector::Impl {
   }
 
   // Tests the feature pairs of a non-adjacent triangle pair whose representative pair it is.
-  // Needs the context's precomputed boxes. Box test first (cheap, rejects most), then ownership.
+  // Needs the context's precomputed boxes.
   template <class Out, class KernelVf, class KernelEe>
   void triangle_pair(const detail::FeatureContext& ctx, int f, int g, Out& out, KernelVf&& kvf,
                      KernelEe&& kee) const {
-    const Face& tf = topo.faces()[f];
-    const Face& tg = topo.faces()[g];
-    const detail::Box& bf = ctx.fboxes[f];
-    const detail::Box& bg = ctx.fboxes[g];
-    // Ownership: a set bit of first_mask settles it; otherwise the ordered search decides.
-    const unsigned mf = owner.first_mask(f), mg = owner.first_mask(g);
-    for (int k = 0; k < 3; ++k) {
-      const int v = tf[k];
-      if (!detail::overlap(ctx.vboxes[v], bg)) continue;
-      if (!((mf >> k) & 1u) && !owner.owns_vf(v, g, f)) continue;
-      if (!vf_in_scope(v, g)) continue;
-      kvf(v, g, out);
-    }
-    for (int k = 0; k < 3; ++k) {
-      const int v = tg[k];
-      if (!detail::overlap(ctx.vboxes[v], bf)) continue;
-      if (!((mg >> k) & 1u) && !owner.owns_vf(v, f, g)) continue;
-      if (!vf_in_scope(v, f)) continue;
-      kvf(v, f, out);
-    }
-    const auto& ef = topo.face_edges(f);
-    const auto& eg = topo.face_edges(g);
-    const detail::Box bg_edges[3] = {ctx.eboxes[eg[0]], ctx.eboxes[eg[1]], ctx.eboxes[eg[2]]};
-    for (int i = 0; i < 3; ++i) {
-      const detail::Box& ba = ctx.eboxes[ef[i]];
-      if (!detail::overlap(ba, bg)) continue;  // edge of f misses all of g
-      for (int j = 0; j < 3; ++j) {
-        if (!detail::overlap(ba, bg_edges[j])) continue;
-        const int ea = ef[i], eb = eg[j];
-        const bool a_first = ea < eb;
-        const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;
-        const bool mine = ((mf >> (3 + i)) & (mg >> (3 + j)) & 1u) ||
-                          (a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f));
-        if (!mine || !ee_in_scope(e1, e2)) continue;
-        kee(e1, e2, out);
-      }
-    }
+    detail::owned_feature_pairs(
+        topo, owner, detail::StepBoxes{ctx}, f, g,
+        [&](int v, int face) {
+          if (vf_in_scope(v, face)) kvf(v, face, out);
+        },
+        [&](int e1, int e2) {
+          if (ee_in_scope(e1, e2)) kee(e1, e2, out);
+        });
   }
 
   DetectResult detect(detail::PointsIn p0, detail::PointsIn p1) {

@@ -14,58 +14,25 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "ccd/face_bounds.hpp"
+#include "clothcd/bvh/aabb.hpp"
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/types.hpp"
 #include "core/moved_vertices.hpp"
-#include "core/ulp.hpp"
 
 namespace clothcd::detail {
 
 /// Swept box of a feature, stored in float (half the memory traffic of the narrow phase, whose
 /// box tests are memory-bound), rounded outwards so it still contains the double box.
-struct Box {
-  float lo[3], hi[3];
-};
-
-inline float round_down(double x) {
-  const float f = static_cast<float>(x);
-  return f > x ? next_down(f) : f;
-}
-inline float round_up(double x) {
-  const float f = static_cast<float>(x);
-  return f < x ? next_up(f) : f;
-}
+using Box = FeatureBox;
+using clothcd::overlap;
 
 inline Box swept_box(std::initializer_list<const Eigen::Vector3d*> pts, double margin) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (const Eigen::Vector3d* p : pts) {
-    lo = lo.cwiseMin(*p);
-    hi = hi.cwiseMax(*p);
-  }
-  if (margin > 0) {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = next_down(lo[k] - margin);
-      hi[k] = next_up(hi[k] + margin);
-    }
-  }
-  Box b;
-  for (int k = 0; k < 3; ++k) {
-    b.lo[k] = round_down(lo[k]);
-    b.hi[k] = round_up(hi[k]);
-  }
-  return b;
-}
-
-// Non-short-circuit `&`: one branch per test instead of up to six badly predicted ones (the
-// narrow phase's box tests fail about half the time, in no pattern).
-inline bool overlap(const Box& a, const Box& b) {
-  return (a.lo[0] <= b.hi[0]) & (a.lo[1] <= b.hi[1]) & (a.lo[2] <= b.hi[2]) & (b.lo[0] <= a.hi[0]) &
-         (b.lo[1] <= a.hi[1]) & (b.lo[2] <= a.hi[2]);
+  return swept_feature_box(pts, margin);
 }
 
 inline bool share_vertex(const Face& a, const Face& b) {
@@ -138,10 +105,21 @@ struct FeatureContext {
                                   ccd.thickness, bound_t1);
   }
 
+  /// Whether a vertex of the pair is linked to one of the other: such pairs are never tested.
+  [[nodiscard]] bool vf_linked(int v, int f) const {
+    const Face& t = topo->faces()[f];
+    return grouped(v, t[0]) || grouped(v, t[1]) || grouped(v, t[2]);
+  }
+  [[nodiscard]] bool ee_linked(int ea, int eb) const {
+    const Edge& a = topo->edges()[ea];
+    const Edge& b = topo->edges()[eb];
+    return grouped(a[0], b[0]) || grouped(a[0], b[1]) || grouped(a[1], b[0]) || grouped(a[1], b[1]);
+  }
+
   /// Vertex v against face f (their boxes already overlap): NP filter, then the kernel.
   void kernel_vf(int v, int f, FeatureCounters& c, std::vector<VertexFaceCollision>& out) const {
+    if (vf_linked(v, f)) return;
     const Face& t = topo->faces()[f];
-    if (grouped(v, t[0]) || grouped(v, t[1]) || grouped(v, t[2])) return;
     const VertexFaceQuery q{v0[v], v0[t[0]], v0[t[1]], v0[t[2]],
                             v1[v], v1[t[0]], v1[t[1]], v1[t[2]]};
     double toi = 1.0;
@@ -150,11 +128,9 @@ struct FeatureContext {
 
   /// Edges ea < eb (their boxes already overlap).
   void kernel_ee(int ea, int eb, FeatureCounters& c, std::vector<EdgeEdgeCollision>& out) const {
+    if (ee_linked(ea, eb)) return;
     const Edge& a = topo->edges()[ea];
     const Edge& b = topo->edges()[eb];
-    if (grouped(a[0], b[0]) || grouped(a[0], b[1]) || grouped(a[1], b[0]) || grouped(a[1], b[1])) {
-      return;
-    }
     const EdgeEdgeQuery q{v0[a[0]], v0[a[1]], v0[b[0]], v0[b[1]],
                           v1[a[0]], v1[a[1]], v1[b[0]], v1[b[1]]};
     double toi = 1.0;
@@ -446,6 +422,71 @@ class Ownership {
   std::vector<std::uint8_t> first_;
   std::vector<EdgeFaces> pair_;
 };
+
+/// A step's precomputed swept boxes (FeatureContext::vboxes, eboxes, fboxes) for
+/// owned_feature_pairs.
+struct StepBoxes {
+  const FeatureContext& ctx;
+  [[nodiscard]] const Box& vertex(int v) const { return ctx.vboxes[v]; }
+  [[nodiscard]] const Box& edge(int e) const { return ctx.eboxes[e]; }
+  [[nodiscard]] const Box& face(int f) const { return ctx.fboxes[f]; }
+};
+
+/// No geometry for owned_feature_pairs: every box overlaps every other, so it yields every
+/// feature pair the triangle pair owns.
+struct NoBoxes {
+  struct Any {};
+  [[nodiscard]] Any vertex(int) const { return {}; }
+  [[nodiscard]] Any edge(int) const { return {}; }
+  [[nodiscard]] Any face(int) const { return {}; }
+};
+inline bool overlap(NoBoxes::Any, NoBoxes::Any) {
+  return true;
+}
+
+/// The feature pairs of the triangle pair (f, g), sharing no vertex, whose R-triangle pair it is
+/// (docs/algorithms.md 6.3) and whose boxes overlap: vf(v, face) for a vertex of one face against
+/// the other, ee(e1, e2) with e1 < e2 for an edge of each. Box tests first (cheap, they reject
+/// most), then ownership: a set bit of first_mask settles it, otherwise the ordered search.
+template <class Boxes, class Vf, class Ee>
+void owned_feature_pairs(const Topology& topo, const Ownership& owner, const Boxes& boxes, int f,
+                         int g, Vf&& vf, Ee&& ee) {
+  const Face& tf = topo.faces()[f];
+  const Face& tg = topo.faces()[g];
+  const auto& bf = boxes.face(f);
+  const auto& bg = boxes.face(g);
+  const unsigned mf = owner.first_mask(f), mg = owner.first_mask(g);
+  for (int k = 0; k < 3; ++k) {
+    const int v = tf[k];
+    if (!overlap(boxes.vertex(v), bg)) continue;
+    if (!((mf >> k) & 1u) && !owner.owns_vf(v, g, f)) continue;
+    vf(v, g);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const int v = tg[k];
+    if (!overlap(boxes.vertex(v), bf)) continue;
+    if (!((mg >> k) & 1u) && !owner.owns_vf(v, f, g)) continue;
+    vf(v, f);
+  }
+  const auto& ef = topo.face_edges(f);
+  const auto& eg = topo.face_edges(g);
+  using B = std::decay_t<decltype(boxes.edge(0))>;
+  const B bg_edges[3] = {boxes.edge(eg[0]), boxes.edge(eg[1]), boxes.edge(eg[2])};
+  for (int i = 0; i < 3; ++i) {
+    const B& ba = boxes.edge(ef[i]);
+    if (!overlap(ba, bg)) continue;  // edge of f misses all of g
+    for (int j = 0; j < 3; ++j) {
+      if (!overlap(ba, bg_edges[j])) continue;
+      const int ea = ef[i], eb = eg[j];
+      const bool a_first = ea < eb;
+      const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;
+      const bool mine = ((mf >> (3 + i)) & (mg >> (3 + j)) & 1u) ||
+                        (a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f));
+      if (!mine) continue;
+      ee(e1, e2);
+    }
+  }
+}
 
 inline bool vf_less(const VertexFaceCollision& a, const VertexFaceCollision& b) {
   return a.vertex < b.vertex || (a.vertex == b.vertex && a.face < b.face);

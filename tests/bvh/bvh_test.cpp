@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <set>
 
@@ -131,6 +133,56 @@ TEST(Bvh, RefitChangedEqualsFullRefitAfterEveryCall) {
       }
     }
   }
+}
+
+// A Bvh owns what its refits read: built from a Topology that is then moved from and destroyed,
+// it (and a copy, and a moved tree) refits to the same boxes, cones and contours as a tree whose
+// Topology is still alive.
+TEST(Bvh, OutlivesItsTopology) {
+  const ProceduralScene s = crumpled_sheet(8, 7);
+  const auto v0 = points(s.v_t0), v1 = points(s.v_t1);
+  const Topology kept(s.faces, s.num_vertices);
+  Bvh reference(kept, v0, BvhBuild::Patch);
+  Bvh orphaned, boxes;
+  {
+    auto gone = std::make_unique<Topology>(s.faces, s.num_vertices);
+    orphaned = Bvh(*gone, v0, BvhBuild::Patch);
+    boxes = Bvh::boxes_only(*gone, v0, BvhBuild::Patch);
+    [[maybe_unused]] const Topology moved_to = std::move(*gone);  // leaves the original empty
+    gone.reset();
+  }
+  Bvh copied = orphaned;
+  Bvh moved = std::move(orphaned);
+  EXPECT_EQ(moved.faces(), s.faces);
+  EXPECT_EQ(moved.num_vertices(), s.num_vertices);
+  RefitOptions ro;
+  ro.policy = ConePolicy::Exact;
+  reference.refit(v0, v1, ro);
+  for (Bvh* b : {&copied, &moved}) {
+    b->refit(v0, v1, ro);
+    ASSERT_EQ(b->nodes().size(), reference.nodes().size());
+    for (std::size_t i = 0; i < reference.nodes().size(); ++i) {
+      EXPECT_EQ(b->nodes()[i].lo, reference.nodes()[i].lo);
+      EXPECT_EQ(b->nodes()[i].hi, reference.nodes()[i].hi);
+      EXPECT_EQ(b->nodes()[i].flags, reference.nodes()[i].flags);
+      EXPECT_EQ(b->cones()[i].axis, reference.cones()[i].axis);
+      EXPECT_EQ(b->cones()[i].half_angle, reference.cones()[i].half_angle);
+      const auto c = b->contour(static_cast<int>(i)), r = reference.contour(static_cast<int>(i));
+      EXPECT_TRUE(std::equal(c.begin(), c.end(), r.begin(), r.end()));
+    }
+  }
+  // refit_changed looks up the faces of the moved vertices in the tree's own copy.
+  auto v1b = v1;
+  v1b[3] += Eigen::Vector3d(0.01, 0.02, -0.01);
+  moved.refit_changed(v0, v1, ro);
+  moved.refit_changed(v0, v1b, ro);
+  reference.refit(v0, v1b, ro);
+  for (std::size_t i = 0; i < reference.nodes().size(); ++i) {
+    EXPECT_EQ(moved.nodes()[i].lo, reference.nodes()[i].lo);
+    EXPECT_EQ(moved.nodes()[i].hi, reference.nodes()[i].hi);
+  }
+  boxes.refit(v0, RefitOptions{});
+  EXPECT_EQ(boxes.nodes().size(), reference.nodes().size());
 }
 
 // A boxes-only build: the full build's nodes, permutation and boxes, without flags or contours.

@@ -1,5 +1,5 @@
 // next_up / next_down against std::nextafter: the boxes must round exactly as before.
-#include "core/ulp.hpp"
+#include "clothcd/core/ulp.hpp"
 
 #include <gtest/gtest.h>
 

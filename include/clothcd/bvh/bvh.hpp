@@ -14,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "clothcd/bvh/aabb.hpp"
 #include "clothcd/geometry/cone.hpp"
 #include "clothcd/mesh/topology.hpp"
 
@@ -52,8 +53,7 @@ static_assert(sizeof(BvhNode) == 64, "BvhNode must stay one cache line");
 
 /// Box overlap of two nodes (closed boxes).
 [[nodiscard]] inline bool overlap(const BvhNode& a, const BvhNode& b) {
-  return a.lo[0] <= b.hi[0] && b.lo[0] <= a.hi[0] && a.lo[1] <= b.hi[1] && b.lo[1] <= a.hi[1] &&
-         a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
+  return overlap(a.lo, a.hi, b.lo, b.hi);
 }
 
 /// Options of a refit.
@@ -72,7 +72,8 @@ class Bvh {
  public:
   Bvh() = default;
   /// Builds over all faces of `topology` using the reference positions (n x 3) for the splits.
-  /// The topology must outlive the Bvh.
+  /// The tree keeps a copy of the faces it needs: it stays valid, and can be copied and moved,
+  /// independently of `topology`.
   Bvh(const Topology& topology, std::span<const Eigen::Vector3d> reference, BvhBuild build);
   /// The same tree without the per-node topology flags and contours, which take about half of a
   /// build's time: for box-only traversals that rebuild their tree as the mesh deforms. Every
@@ -94,7 +95,10 @@ class Bvh {
   /// (kSaturatedHalfAngle), pi for an internal node above a saturated child. Test it with
   /// NormalCone::saturated(), not by comparing the angle.
   [[nodiscard]] const std::vector<NormalCone>& cones() const { return cones_; }
-  [[nodiscard]] const Topology& topology() const { return *topology_; }
+  /// The faces the tree was built over (its own copy); refits read positions by these ids.
+  [[nodiscard]] const std::vector<Face>& faces() const { return faces_; }
+  /// Number of vertices of the topology the tree was built from.
+  [[nodiscard]] int num_vertices() const { return num_vertices_; }
   /// Sum of the internal nodes' box surface areas over the leaves', at the last refit. A tree
   /// refit to shapes far from the one it was built on has ever looser boxes, and this ratio grows
   /// with them (the multilayer garment on the kick: 6.1 built, 21 at frame 90, 8.1 rebuilt
@@ -131,10 +135,12 @@ class Bvh {
   void refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
                    const RefitOptions& options, std::span<const std::uint8_t> nodes);
   void forget_changes();
-  void compute_flags();
-  void build_tree(std::span<const Eigen::Vector3d> reference, BvhBuild build);
+  void compute_flags(const Topology& topology);
+  void build_tree(const Topology& topology, std::span<const Eigen::Vector3d> reference,
+                  BvhBuild build);
 
-  const Topology* topology_ = nullptr;
+  std::vector<Face> faces_;
+  int num_vertices_ = 0;
   std::vector<BvhNode> nodes_;
   std::vector<int> prim_ids_;
   std::vector<int> leaf_of_face_;
