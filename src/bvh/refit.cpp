@@ -116,15 +116,34 @@ void Bvh::refit_changed(std::span<const Eigen::Vector3d> v_t0,
                         std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options) {
   if (changed_options_ != options) forget_changes();
   const auto moved = detail::moved_vertices(changed_t0_, changed_t1_, v_t0, v_t1);
+  refit_flagged(v_t0, v_t1, options,
+                moved ? std::span<const std::uint8_t>(*moved) : std::span<const std::uint8_t>{});
+}
+
+void Bvh::refit_moved(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                      const RefitOptions& options, std::span<const std::uint8_t> moved) {
+  if (changed_options_ != options || moved.size() != static_cast<std::size_t>(num_vertices_)) {
+    moved = {};
+  }
+  // refit_changed()'s copies are now stale: its next call refits everything and keeps new ones.
+  changed_t0_.clear();
+  changed_t1_.clear();
+  refit_flagged(v_t0, v_t1, options, moved);
+}
+
+void Bvh::refit_flagged(std::span<const Eigen::Vector3d> v_t0,
+                        std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options,
+                        std::span<const std::uint8_t> moved) {
   std::vector<std::uint8_t> touched;
-  if (moved) {
+  if (!moved.empty()) {
     touched.assign(faces_.size(), 0);
     for (std::size_t f = 0; f < faces_.size(); ++f) {
       for (int v : faces_[f])
-        touched[f] |= (*moved)[v];
+        touched[f] |= moved[v];
     }
   }
-  refit_nodes(v_t0, v_t1, options, moved ? nodes_holding(touched) : std::vector<std::uint8_t>{});
+  refit_nodes(v_t0, v_t1, options,
+              moved.empty() ? std::vector<std::uint8_t>{} : nodes_holding(touched));
   changed_options_ = options;
 }
 

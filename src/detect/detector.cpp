@@ -63,7 +63,12 @@ struct SelfDetector::Impl {
   DetectOptions opt;
   Bvh bvh;
   detail::Orphans orphans;
-  std::vector<Eigen::Vector3d> v0, v1;
+  // The positions of the last call, and which vertices changed since the call before: one copy
+  // and one comparison a call, shared by the refit and the feature boxes.
+  detail::StepPositions step;
+  const std::vector<Eigen::Vector3d>& v0 = step.x0();
+  const std::vector<Eigen::Vector3d>& v1 = step.x1();
+  std::uint64_t bvh_call = 0;  // the call of `step` the tree was last swept at (0: none)
   // Active restriction: features on active faces, and the nodes holding a face that touches one.
   // `outside` turns it into its complement (the pairs the restriction leaves out).
   bool restricted = false;
@@ -89,8 +94,9 @@ struct SelfDetector::Impl {
   Impl(std::vector<Face> faces, int nv, detail::PointsIn ref, const DetectOptions& o)
       : topo(std::move(faces), nv), opt(o) {
     check_options(o);
-    detail::to_points(ref, nv, "reference shape", v0);
-    bvh = Bvh(topo, v0, o.build);
+    std::vector<Eigen::Vector3d> reference;
+    detail::to_points(ref, nv, "reference shape", reference);
+    bvh = Bvh(topo, reference, o.build);
     orphans = detail::find_orphans(topo);
     owner = detail::Ownership(topo);
   }
@@ -311,8 +317,7 @@ struct SelfDetector::Impl {
   }
 
   DetectResult detect(detail::PointsIn p0, detail::PointsIn p1) {
-    detail::to_points(p0, topo.num_vertices(), "positions at t0", v0);
-    detail::to_points(p1, topo.num_vertices(), "positions at t1", v1);
+    step.update(p0, p1, topo.num_vertices(), "positions at t0", "positions at t1");
     if (!links_current) {
       links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
       links_current = true;
@@ -325,7 +330,8 @@ struct SelfDetector::Impl {
     ro.cones = cones_used(rule());
     ro.policy = opt.policy;
     ro.optimal_cones = opt.research.optimal_cones;
-    bvh.refit_changed(v0, v1, ro);
+    bvh.refit_moved(v0, v1, ro, step.changed_since(bvh_call));
+    bvh_call = step.call();
     st.time_refit = seconds_since(t);
     st.internal_nodes = bvh.num_internal();
     st.connected_internal_nodes = bvh.num_connected_internal();
@@ -336,7 +342,7 @@ struct SelfDetector::Impl {
     st.time_traverse = seconds_since(t);
     t = Clock::now();
     detail::FeatureContext ctx = ccd_context();
-    boxes.update(ctx);
+    boxes.update(ctx, step);
     const bool keep = keeps() && !restricted;
     std::vector<std::uint8_t> near;
     narrow(ctx, pairs, res, keep ? &near : nullptr);
@@ -369,14 +375,14 @@ struct SelfDetector::Impl {
     if (!(h >= 0) || !std::isfinite(h)) {
       throw InputError(fmt::format("proximity distance must be finite and >= 0, got {}", h));
     }
-    detail::to_points(p, topo.num_vertices(), "positions", v0);
-    v1 = v0;
+    step.update_static(p, topo.num_vertices(), "positions");
     RefitOptions ro;
     ro.thickness = h;
     ro.cones = false;  // cones carry no distance information (docs/algorithms.md 1.1)
     bvh.refit(v0, ro);
+    bvh_call = 0;
     detail::FeatureContext ctx = detail::proximity_context(topo, v0, h);
-    boxes.update(ctx);
+    boxes.update(ctx, step);
     struct Buffer {
       std::vector<ProximityResult::VertexFace> vf;
       std::vector<ProximityResult::EdgeEdge> ee;
@@ -519,6 +525,7 @@ void rebuild_detector(Impl& im, detail::PointsIn reference) {
   std::vector<Eigen::Vector3d> ref;
   detail::to_points(reference, im.topo.num_vertices(), "reference shape", ref);
   im.bvh = Bvh(im.topo, ref, im.opt.build);
+  im.bvh_call = 0;
   im.restricted = false;  // its node flags belonged to the old tree
 }
 }  // namespace

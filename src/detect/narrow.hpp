@@ -22,7 +22,7 @@
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/types.hpp"
-#include "core/moved_vertices.hpp"
+#include "detect/step_positions.hpp"
 
 namespace clothcd::detail {
 
@@ -232,24 +232,25 @@ inline FeatureContext proximity_context(const Topology& topo, std::span<const Ei
 /// a pass on multilayer-rumba).
 class FeatureBoxes {
  public:
-  /// Brings the boxes up to date with ctx's positions and margin and points ctx at them.
-  void update(FeatureContext& ctx) {
+  /// Brings the boxes up to date with ctx's positions and margin and points ctx at them. ctx's
+  /// positions must be `step`'s current ones: when the boxes were last updated at the previous
+  /// call of `step` with the same margin, only the features of its changed vertices are redone.
+  void update(FeatureContext& ctx, const StepPositions& step) {
     const Topology& topo = *ctx.topo;
     const int nv = topo.num_vertices();
-    if (margin_ != ctx.margin) {  // every box changes: start over
-      x0_.clear();
-      margin_ = ctx.margin;
-    }
-    const auto moved = moved_vertices(x0_, x1_, ctx.v0, ctx.v1);
-    if (!moved) {
+    std::span<const std::uint8_t> moved = step.changed_since(call_);
+    if (margin_ != ctx.margin) moved = {};  // every box changes: start over
+    margin_ = ctx.margin;
+    call_ = step.call();
+    if (moved.empty()) {
       vboxes_.resize(nv);
       eboxes_.resize(topo.num_edges());
       fboxes_.resize(topo.num_faces());
     }
     const auto redo = [&](auto&& ids) {  // a vertex of the feature moved (or all did)
-      if (!moved) return true;
+      if (moved.empty()) return true;
       for (int v : ids) {
-        if ((*moved)[v]) return true;
+        if (moved[v]) return true;
       }
       return false;
     };
@@ -293,7 +294,7 @@ class FeatureBoxes {
   }
 
   std::vector<Box> vboxes_, eboxes_, fboxes_;
-  std::vector<Eigen::Vector3d> x0_, x1_;  // the positions the boxes were computed from
+  std::uint64_t call_ = 0;  // the StepPositions call the boxes were computed at (0: none)
   double margin_ = -1.0;
 };
 

@@ -60,14 +60,27 @@ struct Side {
   Topology topo;
   Bvh bvh;
   detail::FeatureBoxes boxes;
-  std::vector<Eigen::Vector3d> x0, x1;
+  // The positions of the current call and which vertices changed since the one before.
+  detail::StepPositions step;
+  const std::vector<Eigen::Vector3d>& x0 = step.x0();
+  const std::vector<Eigen::Vector3d>& x1 = step.x1();
+  std::uint64_t bvh_call = 0;  // the call of `step` the tree was last swept at (0: none)
   // Active vertices, the edges and faces touching one, and the nodes holding such a face.
   std::vector<std::uint8_t> vertex_active, edge_active, face_active, node_active;
 
   Side(std::vector<Face> faces, int nv, detail::PointsIn ref, std::string_view name, BvhBuild build)
       : topo(std::move(faces), nv) {
-    detail::to_points(ref, nv, name, x0);
-    bvh = Bvh::boxes_only(topo, x0, build);  // no cones: they cannot cull between two meshes
+    std::vector<Eigen::Vector3d> reference;
+    detail::to_points(ref, nv, name, reference);
+    bvh = Bvh::boxes_only(topo, reference, build);  // no cones: they cannot cull between meshes
+  }
+  Side(const Side&) = delete;  // x0 and x1 refer into `step`
+  Side& operator=(const Side&) = delete;
+
+  // The swept boxes of a CCD call (the tree redoes only what changed since its last one).
+  void sweep(const RefitOptions& options) {
+    bvh.refit_moved(x0, x1, options, step.changed_since(bvh_call));
+    bvh_call = step.call();
   }
 
   void set_active(std::span<const int> vertices, std::string_view mesh) {
@@ -227,16 +240,14 @@ struct PairDetector::Impl {
 
   PairDetectResult detect(detail::PointsIn a_t0, detail::PointsIn a_t1, detail::PointsIn b_t0,
                           detail::PointsIn b_t1) {
-    detail::to_points(a_t0, a.topo.num_vertices(), "mesh A at t0", a.x0);
-    detail::to_points(a_t1, a.topo.num_vertices(), "mesh A at t1", a.x1);
-    detail::to_points(b_t0, b.topo.num_vertices(), "mesh B at t0", b.x0);
-    detail::to_points(b_t1, b.topo.num_vertices(), "mesh B at t1", b.x1);
+    a.step.update(a_t0, a_t1, a.topo.num_vertices(), "mesh A at t0", "mesh A at t1");
+    b.step.update(b_t0, b_t1, b.topo.num_vertices(), "mesh B at t0", "mesh B at t1");
     auto t = Clock::now();
     RefitOptions ro;
     ro.thickness = opt.thickness;
     ro.cones = false;
-    a.bvh.refit_changed(a.x0, a.x1, ro);
-    b.bvh.refit_changed(b.x0, b.x1, ro);
+    a.sweep(ro);
+    b.sweep(ro);
     const double t_refit = seconds_since(t);
 
     t = Clock::now();
@@ -247,8 +258,8 @@ struct PairDetector::Impl {
     t = Clock::now();
     detail::FeatureContext ca = detail::ccd_context(a.topo, a.x0, a.x1, opt);
     detail::FeatureContext cb = detail::ccd_context(b.topo, b.x0, b.x1, opt);
-    a.boxes.update(ca);
-    b.boxes.update(cb);
+    a.boxes.update(ca, a.step);
+    b.boxes.update(cb, b.step);
     tbb::enumerable_thread_specific<Buffer> locals;
     const Scope scope{*this};
     tbb::parallel_for(
@@ -298,21 +309,20 @@ struct PairDetector::Impl {
     if (!(h >= 0) || !std::isfinite(h)) {
       throw InputError(fmt::format("proximity distance must be finite and >= 0, got {}", h));
     }
-    detail::to_points(pa, a.topo.num_vertices(), "mesh A positions", a.x0);
-    detail::to_points(pb, b.topo.num_vertices(), "mesh B positions", b.x0);
-    a.x1 = a.x0;
-    b.x1 = b.x0;
+    a.step.update_static(pa, a.topo.num_vertices(), "mesh A positions");
+    b.step.update_static(pb, b.topo.num_vertices(), "mesh B positions");
     RefitOptions ro;
     ro.thickness = h;
     ro.cones = false;
     a.bvh.refit(a.x0, ro);
     b.bvh.refit(b.x0, ro);
+    a.bvh_call = b.bvh_call = 0;
     DetectStats st;
     const auto pairs = traverse(st);
     detail::FeatureContext ca = detail::proximity_context(a.topo, a.x0, h);
     detail::FeatureContext cb = detail::proximity_context(b.topo, b.x0, h);
-    a.boxes.update(ca);
-    b.boxes.update(cb);
+    a.boxes.update(ca, a.step);
+    b.boxes.update(cb, b.step);
     const auto& faces_a = a.topo.faces();
     const auto& faces_b = b.topo.faces();
     const auto& edges_a = a.topo.edges();
@@ -380,6 +390,7 @@ void rebuild_detector(Impl& m, detail::PointsIn reference_a, detail::PointsIn re
   detail::to_points(reference_b, m.b.topo.num_vertices(), "reference shape B", rb);
   m.a.bvh = Bvh::boxes_only(m.a.topo, ra, m.opt.build);
   m.b.bvh = Bvh::boxes_only(m.b.topo, rb, m.opt.build);
+  m.a.bvh_call = m.b.bvh_call = 0;
   m.restricted = false;  // its node flags belonged to the old trees
 }
 }  // namespace

@@ -91,9 +91,9 @@ TEST(Bvh, StructureAndFlagsMatchBruteForce) {
   }
 }
 
-// refit_changed over a sequence of calls (a few vertices moved, a static refit between, other
-// options) gives after every call, bit for bit, the boxes and cones of a fresh full refit, for
-// every cone policy.
+// refit_changed, and refit_moved with the moved vertices flagged, over a sequence of calls (a few
+// vertices moved, a static refit between, other options, a switch from one to the other) give
+// after every call, bit for bit, the boxes and cones of a fresh full refit, for every policy.
 TEST(Bvh, RefitChangedEqualsFullRefitAfterEveryCall) {
   for (const auto& s : {crumpled_sheet(8, 7), twisted_strip(30, 3), stacked_sheets(6)}) {
     const Topology topo(s.faces, s.num_vertices);
@@ -108,27 +108,44 @@ TEST(Bvh, RefitChangedEqualsFullRefitAfterEveryCall) {
                    << s.name << " policy " << int(policy) << " optimal " << optimal);
       auto v1 = points(s.v_t1);
       Bvh reused(topo, v0, BvhBuild::Spatial);
+      Bvh flagged(topo, v0, BvhBuild::Spatial);
+      auto last_v1 = v1;
       RefitOptions ro;
       ro.policy = policy;
       ro.optimal_cones = optimal;
       ro.thickness = 1e-3;
       for (int call = 0; call < 6; ++call) {
-        if (call == 3) reused.refit(v0, ro);  // static: the next call starts over
-        if (call == 4) ro.thickness = 2e-3;   // other options: likewise
+        if (call == 3) {  // static: the next call starts over
+          reused.refit(v0, ro);
+          flagged.refit(v0, ro);
+        }
+        if (call == 4) ro.thickness = 2e-3;  // other options: likewise
         if (call > 0) {
           for (std::size_t v = call; v < v1.size(); v += 11)
             v1[v] += Eigen::Vector3d(0.02 * call, -0.01, 0.03);
         }
         reused.refit_changed(v0, v1, ro);
+        // The vertices whose motion changed since the last call (v0 stays).
+        std::vector<std::uint8_t> moved(v1.size(), 0);
+        for (std::size_t v = 0; v < v1.size(); ++v)
+          moved[v] = v1[v] != last_v1[v] ? 1 : 0;
+        last_v1 = v1;
+        if (call == 5) {
+          flagged.refit_changed(v0, v1, ro);  // after refit_moved: no copies, a full refit
+        } else {
+          flagged.refit_moved(v0, v1, ro, moved);
+        }
         Bvh fresh(topo, v0, BvhBuild::Spatial);
         fresh.refit(v0, v1, ro);
-        for (std::size_t i = 0; i < fresh.nodes().size(); ++i) {
-          for (int k = 0; k < 3; ++k) {
-            ASSERT_EQ(reused.nodes()[i].lo[k], fresh.nodes()[i].lo[k]) << "call " << call;
-            ASSERT_EQ(reused.nodes()[i].hi[k], fresh.nodes()[i].hi[k]) << "call " << call;
+        for (const Bvh* tree : {&reused, &flagged}) {
+          for (std::size_t i = 0; i < fresh.nodes().size(); ++i) {
+            for (int k = 0; k < 3; ++k) {
+              ASSERT_EQ(tree->nodes()[i].lo[k], fresh.nodes()[i].lo[k]) << "call " << call;
+              ASSERT_EQ(tree->nodes()[i].hi[k], fresh.nodes()[i].hi[k]) << "call " << call;
+            }
+            ASSERT_EQ(tree->cones()[i].axis, fresh.cones()[i].axis) << "call " << call;
+            ASSERT_EQ(tree->cones()[i].half_angle, fresh.cones()[i].half_angle) << "call " << call;
           }
-          ASSERT_EQ(reused.cones()[i].axis, fresh.cones()[i].axis) << "call " << call;
-          ASSERT_EQ(reused.cones()[i].half_angle, fresh.cones()[i].half_angle) << "call " << call;
         }
       }
     }

@@ -123,6 +123,14 @@ class Bvh {
   /// change their motion.
   void refit_changed(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
                      const RefitOptions& options);
+  /// refit_changed() for a caller that already knows which vertices changed: `moved` flags (one
+  /// per vertex) every vertex whose position at t0 or t1 differs from the one this tree's
+  /// previous refit used. The result is refit(v_t0, v_t1, options) bit for bit when the flags
+  /// are right; a vertex changed but not flagged leaves stale boxes. Empty `moved`, other
+  /// options than the previous refit_changed() / refit_moved(), or another refit since, refit
+  /// every node. Saves refit_changed()'s copy and comparison of the positions.
+  void refit_moved(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                   const RefitOptions& options, std::span<const std::uint8_t> moved);
   /// Static boxes and skinny (DCD) cones at the positions v.
   void refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options);
 
@@ -134,6 +142,9 @@ class Bvh {
   // nodes_holding gives them); the others keep their last refit's box and cone.
   void refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
                    const RefitOptions& options, std::span<const std::uint8_t> nodes);
+  // refit_nodes() of the nodes above the flagged vertices (all when `moved` is empty).
+  void refit_flagged(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                     const RefitOptions& options, std::span<const std::uint8_t> moved);
   void forget_changes();
   void compute_flags(const Topology& topology);
   void build_tree(const Topology& topology, std::span<const Eigen::Vector3d> reference,
