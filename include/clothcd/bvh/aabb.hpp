@@ -31,8 +31,9 @@ using FeatureBox = Aabb<float>;
 /// without short-circuit: one branch per test instead of up to six badly predicted ones.
 template <class V>
 [[nodiscard]] inline bool overlap(const V& alo, const V& ahi, const V& blo, const V& bhi) {
-  return (alo[0] <= bhi[0]) & (alo[1] <= bhi[1]) & (alo[2] <= bhi[2]) & (blo[0] <= ahi[0]) &
-         (blo[1] <= ahi[1]) & (blo[2] <= ahi[2]);
+  const int hit = int(alo[0] <= bhi[0]) & int(alo[1] <= bhi[1]) & int(alo[2] <= bhi[2]) &
+                  int(blo[0] <= ahi[0]) & int(blo[1] <= ahi[1]) & int(blo[2] <= ahi[2]);
+  return hit != 0;
 }
 template <class T>
 [[nodiscard]] inline bool overlap(const Aabb<T>& a, const Aabb<T>& b) {
