@@ -286,11 +286,7 @@ struct SelfDetector::Impl {
     st.vf_orphans = orphans.vf.size();
     st.ee_orphans = orphans.ee.size();
     for (auto& l : locals) {
-      st.vf_tests += l.c.vf_tests;
-      st.ee_tests += l.c.ee_tests;
-      st.vf_np_culled += l.c.vf_np;
-      st.ee_np_culled += l.c.ee_np;
-      st.triangle_pairs_apart += l.c.faces_apart;
+      l.c.add_to(st);
       st.triangle_pairs += l.c.triangle_pairs;
       res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
       res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());

@@ -47,6 +47,15 @@ struct FeatureCounters {
   std::uint64_t vf_tests = 0, ee_tests = 0, vf_np = 0, ee_np = 0;
   std::uint64_t triangle_pairs = 0;  // triangle pairs reaching the narrow phase
   std::uint64_t faces_apart = 0;     // ... culled whole (FeatureContext::faces_apart)
+
+  /// Adds the feature test counters (not triangle_pairs, which callers count their own way).
+  void add_to(DetectStats& s) const {
+    s.vf_tests += vf_tests;
+    s.ee_tests += ee_tests;
+    s.vf_np_culled += vf_np;
+    s.ee_np_culled += ee_np;
+    s.triangle_pairs_apart += faces_apart;
+  }
 };
 
 /// Positions of one step and the test settings.

@@ -68,10 +68,7 @@ DetectResult brute_force_detect(const Topology& topo, const Positions& p0, const
   });
   DetectResult res;
   for (const auto& l : locals) {
-    res.stats.vf_tests += l.c.vf_tests;
-    res.stats.ee_tests += l.c.ee_tests;
-    res.stats.vf_np_culled += l.c.vf_np;
-    res.stats.ee_np_culled += l.c.ee_np;
+    l.c.add_to(res.stats);
     res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
     res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
   }

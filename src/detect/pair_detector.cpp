@@ -155,11 +155,7 @@ bool ee_hit(const detail::FeatureContext& ca, int ea, const detail::FeatureConte
 PairDetectResult collect(tbb::enumerable_thread_specific<Buffer>& locals) {
   PairDetectResult res;
   for (const auto& l : locals) {
-    res.stats.vf_tests += l.c.vf_tests;
-    res.stats.ee_tests += l.c.ee_tests;
-    res.stats.vf_np_culled += l.c.vf_np;
-    res.stats.ee_np_culled += l.c.ee_np;
-    res.stats.triangle_pairs_apart += l.c.faces_apart;
+    l.c.add_to(res.stats);
     res.vf_a_on_b.insert(res.vf_a_on_b.end(), l.ab.begin(), l.ab.end());
     res.vf_b_on_a.insert(res.vf_b_on_a.end(), l.ba.begin(), l.ba.end());
     res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
