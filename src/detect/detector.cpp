@@ -57,7 +57,7 @@ struct NarrowBuffer {
 
 struct SelfDetector::Impl {
   // The traversal's culling rule: any of the four, the research options' unsound ones included.
-  using Culling = research::CullingRule;
+  using Rule = research::CullingRule;
 
   Topology topo;
   DetectOptions opt;
@@ -101,14 +101,14 @@ struct SelfDetector::Impl {
     owner = detail::Ownership(topo);
   }
 
-  [[nodiscard]] bool cones_used(Culling mode) const { return mode != Culling::None; }
-  [[nodiscard]] Culling rule() const { return research::culling_rule(opt); }
+  [[nodiscard]] bool cones_used(Rule mode) const { return mode != Rule::None; }
+  [[nodiscard]] Rule rule() const { return research::culling_rule(opt); }
 
   // Pairs kept for reuse: not with the unsound rules, which may cull close pairs. Sound culling
   // then certifies its nodes free of feature pairs within reuse_distance too (cull_reach()), so
   // the list holds every overlapping leaf pair that can matter; the boxes reach reuse_distance.
   [[nodiscard]] bool keeps() const {
-    return opt.reuse_distance > 0 && (rule() == Culling::None || rule() == Culling::Sound);
+    return opt.reuse_distance > 0 && (rule() == Rule::None || rule() == Rule::Sound);
   }
   [[nodiscard]] double box_reach() const {
     return keeps() ? std::max(opt.thickness, opt.reuse_distance) : opt.thickness;
@@ -118,7 +118,7 @@ struct SelfDetector::Impl {
   // reuse, the contour test alone proves a node free of contacts; otherwise a node must also
   // keep its non-adjacent features farther apart than the node's reach.
   [[nodiscard]] bool culls_with_reach() const {
-    return rule() == Culling::Sound && (opt.thickness > 0 || keeps());
+    return rule() == Rule::Sound && (opt.thickness > 0 || keeps());
   }
 
   // How close two features of node n may come before the narrow phase could report them: a
@@ -160,21 +160,21 @@ struct SelfDetector::Impl {
   }
 
   // Overlapping non-adjacent leaf pairs of the culled self traversal.
-  std::vector<std::pair<int, int>> traverse(Culling mode, DetectStats& st) {
+  std::vector<std::pair<int, int>> traverse(Rule mode, DetectStats& st) {
     const auto& nodes = bvh.nodes();
     const auto& prims = bvh.prim_ids();
     const auto& cones = bvh.cones();
     const bool use_cones = cones_used(mode);
-    const bool with_reach = mode == Culling::Sound && culls_with_reach();
+    const bool with_reach = mode == Rule::Sound && culls_with_reach();
     auto cull = [&](int i, detail::TraversalCounters& c) {
       if (!use_cones) return false;
       const BvhNode& n = nodes[i];
-      if (mode == Culling::Gated && !n.connected()) return false;
-      if (mode == Culling::Sound && !n.disk()) return false;
+      if (mode == Rule::Gated && !n.connected()) return false;
+      if (mode == Rule::Sound && !n.disk()) return false;
       ++c.cone_tests;
       const NormalCone& k = cones[i];
       if (!(k.half_angle < std::numbers::pi / 2 - kConeMargin)) return false;
-      if (mode != Culling::Sound) return true;
+      if (mode != Rule::Sound) return true;
       ++c.contour_tests;
       // The star test is O(contour); the general simplicity test catches what it cannot.
       bool ok = detail::contour_star_shaped(bvh.contour(i), v0, v1, k.axis) ||
@@ -352,9 +352,9 @@ struct SelfDetector::Impl {
       reuse.valid = true;
     }
 
-    if (opt.research.verify && rule() != Culling::None) {
+    if (opt.research.verify && rule() != Rule::None) {
       DetectResult ref;
-      const auto all = traverse(Culling::None, ref.stats);
+      const auto all = traverse(Rule::None, ref.stats);
       narrow(ctx, all, ref);
       research::Verification& ver = res.verification;
       ver.ran = true;
@@ -425,9 +425,9 @@ struct SelfDetector::Impl {
       test_pairs(reuse.pairs);
       reused = reuse.pairs.size();
       outside = false;
-      test_pairs(traverse(Culling::None, st));
+      test_pairs(traverse(Rule::None, st));
     } else {
-      test_pairs(traverse(Culling::None, st));
+      test_pairs(traverse(Rule::None, st));
     }
     Buffer& out = locals.local();
     for (const auto& [v, f] : orphans.vf) {

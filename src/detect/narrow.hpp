@@ -31,10 +31,6 @@ namespace clothcd::detail {
 using Box = FeatureBox;
 using clothcd::overlap;
 
-inline Box swept_box(std::initializer_list<const Eigen::Vector3d*> pts, double margin) {
-  return swept_feature_box(pts, margin);
-}
-
 inline bool share_vertex(const Face& a, const Face& b) {
   for (int x : a) {
     if (x == b[0] || x == b[1] || x == b[2]) return true;
@@ -80,12 +76,15 @@ struct FeatureContext {
 
   [[nodiscard]] Box compute_face_box(int f) const {
     const Face& t = topo->faces()[f];
-    return swept_box({&v0[t[0]], &v0[t[1]], &v0[t[2]], &v1[t[0]], &v1[t[1]], &v1[t[2]]}, margin);
+    return swept_feature_box({&v0[t[0]], &v0[t[1]], &v0[t[2]], &v1[t[0]], &v1[t[1]], &v1[t[2]]},
+                             margin);
   }
-  [[nodiscard]] Box compute_vertex_box(int v) const { return swept_box({&v0[v], &v1[v]}, margin); }
+  [[nodiscard]] Box compute_vertex_box(int v) const {
+    return swept_feature_box({&v0[v], &v1[v]}, margin);
+  }
   [[nodiscard]] Box compute_edge_box(int e) const {
     const Edge& d = topo->edges()[e];
-    return swept_box({&v0[d[0]], &v0[d[1]], &v1[d[0]], &v1[d[1]]}, margin);
+    return swept_feature_box({&v0[d[0]], &v0[d[1]], &v1[d[0]], &v1[d[1]]}, margin);
   }
   [[nodiscard]] Box face_box(int f) const {
     return fboxes.empty() ? compute_face_box(f) : fboxes[f];
@@ -266,7 +265,7 @@ class FeatureBoxes {
     for_each(nv, [&](int i) {
       if (redo(std::array<int, 1>{i})) vboxes_[i] = ctx.compute_vertex_box(i);
     });
-    // An edge's or face's box is the union of its vertices' boxes bit for bit: swept_box's
+    // An edge's or face's box is the union of its vertices' boxes bit for bit: swept_feature_box's
     // rounding (minus the margin, next_down, to float downwards) is monotone, so the rounded
     // minimum of the points is the minimum of their rounded values (likewise upwards).
     for_each(topo.num_edges(), [&](int e) {
