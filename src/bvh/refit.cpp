@@ -9,6 +9,7 @@
 
 #include "clothcd/bvh/bvh.hpp"
 #include "core/moved_vertices.hpp"
+#include "geometry/patch_cone.hpp"
 
 namespace clothcd {
 namespace {
@@ -46,10 +47,16 @@ void set_box(BvhNode& n, std::initializer_list<const Eigen::Vector3d*> pts) {
 
 }  // namespace
 
-template <class LeafFn>
+template <class LeafFn, class PatchFn>
 void Bvh::refit_levels(const RefitOptions& options, std::span<const std::uint8_t> only,
-                       LeafFn&& leaf) {
+                       int min_count, LeafFn&& leaf, PatchFn&& patch) {
   const bool optimal = options.cones && options.optimal_cones;
+  // A node below min_count triangles gets a cone only where its parent merges it (from its
+  // triangles at once, by `patch`); the nodes below it get none.
+  auto child_cone = [&](int c) -> const NormalCone& {
+    if (nodes_[c].count < min_count && (only.empty() || only[c] != 0)) cones_[c] = patch(c);
+    return cones_[c];
+  };
   if (optimal) {
     control_dirs_.resize(3 * prim_ids_.size());
     degenerate_.resize(prim_ids_.size());
@@ -73,9 +80,9 @@ void Bvh::refit_levels(const RefitOptions& options, std::span<const std::uint8_t
                             n.lo[k] = std::min(l.lo[k], r.lo[k]);
                             n.hi[k] = std::max(l.hi[k], r.hi[k]);
                           }
-                          if (!options.cones) continue;
-                          const NormalCone& cl = cones_[n.left];
-                          const NormalCone& cr = cones_[n.left + 1];
+                          if (!options.cones || n.count < min_count) continue;
+                          const NormalCone& cl = child_cone(n.left);
+                          const NormalCone& cr = child_cone(n.left + 1);
                           // Saturation is monotone up the tree: an enclosing cone is at least as
                           // wide.
                           if (cl.saturated() || cr.saturated()) {
@@ -155,13 +162,20 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
       options.optimal_cones ? LeafConePolicy::Exact : leaf_policy(options.policy);
   const bool optimal = options.cones && options.optimal_cones;
   const auto& faces = faces_;
-  refit_levels(options, nodes, [&](BvhNode& n, int i) {
+  // Optimal cones need every leaf's control directions.
+  const int min_count = optimal ? 0 : options.cone_min_triangles;
+  auto patch = [&](int i) {
+    const BvhNode& n = nodes_[i];
+    return detail::patch_ccd_cone(faces, std::span<const int>(prim_ids_).subspan(n.first, n.count),
+                                  v_t0, v_t1);
+  };
+  auto leaf = [&](BvhNode& n, int i) {
     const Face& t = faces[prim_ids_[n.first]];
     const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
     const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
     set_box(n, {&a0, &b0, &c0, &a1, &b1, &c1});
     inflate(n.lo, n.hi, margin);
-    if (!options.cones) return;
+    if (!options.cones || n.count < min_count) return;
     cones_[i] = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, lp);
     if (optimal) {
       // Bernstein control vectors of the quadratic normal n(t) (docs/algorithms.md 1.3).
@@ -176,7 +190,8 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
       d[2] = bad ? Eigen::Vector3d::UnitZ() : n1.normalized();
       if (bad) cones_[i] = full_cone();
     }
-  });
+  };
+  refit_levels(options, nodes, min_count, leaf, patch);
 }
 
 void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options) {
@@ -184,7 +199,7 @@ void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options)
   const double margin = 0.5 * options.thickness;
   const bool optimal = options.cones && options.optimal_cones;
   const auto& faces = faces_;
-  refit_levels(options, {}, [&](BvhNode& n, int i) {
+  auto leaf = [&](BvhNode& n, int i) {
     const Face& t = faces[prim_ids_[n.first]];
     const Eigen::Vector3d &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
     set_box(n, {&a, &b, &c});
@@ -199,7 +214,9 @@ void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options)
       d[0] = d[1] = d[2] = bad ? Eigen::Vector3d::UnitZ() : nrm.normalized();
       if (bad) cones_[i] = full_cone();
     }
-  });
+  };
+  // Static cones are cheap and rarely used: every node gets one.
+  refit_levels(options, {}, 0, leaf, [](int) { return full_cone(); });
 }
 
 double Bvh::box_area_ratio() const {

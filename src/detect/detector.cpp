@@ -45,6 +45,9 @@ void check_options(const DetectOptions& o) {
     throw InputError(
         fmt::format("reuse distance must be finite and >= 0, got {}", o.reuse_distance));
   }
+  if (o.cull_min_triangles < 0) {
+    throw InputError(fmt::format("cull_min_triangles must be >= 0, got {}", o.cull_min_triangles));
+  }
 }
 
 struct NarrowBuffer {
@@ -135,21 +138,22 @@ struct SelfDetector::Impl {
     return reach * (1 + 1e-9) + detail::kClearanceRounding * scale;
   }
 
-  // The smallest corner clearance (docs/algorithms.md 1.6) over the current step of the
-  // triangles below node n, or a value at most `floor` once one is found below it. Computed only
-  // for the nodes the traversal asks about (their cones and contours passed), and the nodes it
-  // culls are disjoint, so a pass visits few triangles more than once.
-  [[nodiscard]] double corner_clearance(const BvhNode& n, double floor) const {
+  // Whether every triangle below node n keeps, over the current step, its corners more than
+  // reach / cosine from their opposite sides (docs/algorithms.md 1.6): cosine times the smallest
+  // corner clearance exceeds reach. Computed only for the nodes the traversal asks about (their
+  // cones and contours passed), and the nodes it culls are disjoint, so a pass visits few
+  // triangles more than once. A triangle's cheap lower bound settles most of them; the others
+  // take the exact clearance, so the answer is the exact clearances' bit for bit.
+  [[nodiscard]] bool corners_clear(const BvhNode& n, double cosine, double reach) const {
     const auto& prims = bvh.prim_ids();
     const auto& faces = topo.faces();
-    double clearance = std::numeric_limits<double>::infinity();
     for (int k = n.first; k < n.first + n.count; ++k) {
       const Face& f = faces[prims[k]];
-      clearance = std::min(clearance, detail::triangle_corner_clearance(detail::corners(v0, f),
-                                                                        detail::corners(v1, f)));
-      if (!(clearance > floor)) break;
+      const auto x0 = detail::corners(v0, f), x1 = detail::corners(v1, f);
+      if (cosine * detail::triangle_corner_clearance_bound(x0, x1) > reach) continue;
+      if (!(cosine * detail::triangle_corner_clearance(x0, x1) > reach)) return false;
     }
-    return clearance;
+    return true;
   }
 
   [[nodiscard]] bool vf_in_scope(int v, int f) const {
@@ -170,7 +174,7 @@ struct SelfDetector::Impl {
       if (!use_cones) return false;
       const BvhNode& n = nodes[i];
       if (mode == Rule::Gated && !n.connected()) return false;
-      if (mode == Rule::Sound && !n.disk()) return false;
+      if (mode == Rule::Sound && (!n.disk() || n.count < opt.cull_min_triangles)) return false;
       ++c.cone_tests;
       const NormalCone& k = cones[i];
       if (!(k.half_angle < std::numbers::pi / 2 - kConeMargin)) return false;
@@ -183,7 +187,7 @@ struct SelfDetector::Impl {
         // Projected distances are at least cos(half angle) times the 3-D corner clearances.
         const double reach = cull_reach(n);
         const double cosine = std::cos(k.half_angle);
-        ok = cosine * corner_clearance(n, reach / cosine) > reach &&
+        ok = corners_clear(n, cosine, reach) &&
              detail::contour_clear(bvh.contour(i), v0, v1, k.axis, reach);
       }
       if (!ok) ++c.contour_fails;
@@ -326,6 +330,8 @@ struct SelfDetector::Impl {
     ro.cones = cones_used(rule());
     ro.policy = opt.policy;
     ro.optimal_cones = opt.research.optimal_cones;
+    // The unsound rules are measured on every node.
+    if (rule() == Rule::Sound) ro.cone_min_triangles = opt.cull_min_triangles;
     bvh.refit_moved(v0, v1, ro, step.changed_since(bvh_call));
     bvh_call = step.call();
     st.time_refit = seconds_since(t);

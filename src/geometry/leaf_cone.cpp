@@ -1,10 +1,14 @@
 // Leaf cones: the cone of a triangle's normal over a linear motion (CCD, docs/algorithms.md 3.3)
 // and of a static triangle (DCD).
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
+#include "clothcd/geometry/angle.hpp"
 #include "clothcd/geometry/cone.hpp"
+#include "patch_cone.hpp"
 #include "sphere_caps.hpp"
 #include "validate.hpp"
 
@@ -139,5 +143,91 @@ NormalCone dcd_leaf_cone(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   if (!(delta < kSaturatedHalfAngle)) return saturated_cone();
   return leaf_result(n / len, delta);
 }
+
+namespace detail {
+
+NormalCone patch_ccd_cone(std::span<const std::array<int, 3>> faces, std::span<const int> ids,
+                          std::span<const Eigen::Vector3d> v_t0,
+                          std::span<const Eigen::Vector3d> v_t1) {
+  if (ids.empty()) throw std::invalid_argument("patch_ccd_cone: no triangles");
+  // The unnormalized control vectors with their squared lengths, and the cones of the triangles
+  // left to ccd_leaf_cone (extreme scales, or a middle control vector lost in rounding; rare).
+  // One scratch buffer a thread: no allocation once it has grown.
+  struct Control {
+    Eigen::Vector3d n;
+    double q;  // |n|^2
+  };
+  thread_local std::vector<Control> controls;
+  thread_local std::vector<NormalCone> cones;
+  controls.clear();
+  cones.clear();
+  // Squared norms within these bounds, and their products by two, neither overflow nor lose
+  // precision to subnormals, so every bound below holds as computed.
+  constexpr double kLo = 1e-140, kHi = 1e140;
+  auto in_range = [](double x) { return x >= kLo && x <= kHi; };
+  constexpr double u2 = kUnitRoundoff * kUnitRoundoff;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double worst_ratio2 = 0;  // the largest (error / length)^2 of a control vector
+  for (const int id : ids) {
+    const std::array<int, 3>& t = faces[id];
+    const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
+    const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
+    const Eigen::Vector3d e1_t0 = b0 - a0, e2_t0 = c0 - a0;
+    const Eigen::Vector3d e1_t1 = b1 - a1, e2_t1 = c1 - a1;
+    const BernsteinNormal n = bernstein_normal(a0, b0, c0, a1, b1, c1);
+    const double s10 = e1_t0.squaredNorm(), s20 = e2_t0.squaredNorm(), s11 = e1_t1.squaredNorm(),
+                 s21 = e2_t1.squaredNorm();
+    const double q0 = n.n0.squaredNorm(), q1 = n.n1.squaredNorm(), qx = n.nx.squaredNorm();
+    // ccd_leaf_cone's error bounds, squared: (err0 / len0)^2 with err0 = 16 u l10 l20 (the
+    // subnormal term vanishes at these scales, far below the factor two of safety in it), and
+    // errx / lenx <= 8 u sqrt(2 (s10 s21 + s11 s20) / qx) + 2 u, whose square is at most twice
+    // the sum of the terms' squares.
+    if (in_range(s10) && in_range(s20) && in_range(s11) && in_range(s21) && in_range(q0) &&
+        in_range(q1) && in_range(qx)) {
+      const double r0 = 256 * u2 * (s10 * s20) / q0, r1 = 256 * u2 * (s11 * s21) / q1;
+      const double rx = 256 * u2 * (s10 * s21 + s11 * s20) / qx + 8 * u2;
+      if (!(r0 < 1) || !(r1 < 1)) return saturated_cone();  // an end normal may vanish
+      if (rx < 1) {
+        worst_ratio2 = std::max({worst_ratio2, r0, r1, rx});
+        // Unit directions for the axis: weight every control direction alike.
+        for (const auto& [v, q] : {std::pair{&n.n0, q0}, {&n.nx, qx}, {&n.n1, q1}}) {
+          controls.push_back({*v, q});
+          sum += *v / std::sqrt(q);
+        }
+        continue;
+      }
+    }
+    const NormalCone c = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, LeafConePolicy::Exact);
+    if (c.saturated()) return c;
+    cones.push_back(c);
+    sum += c.axis;
+  }
+  const double norm = sum.norm();
+  if (!(norm > 1e-3)) return saturated_cone();
+  const Eigen::Vector3d axis = sum / norm;
+  // Every direction at least ~1e-3 of a unit vector off the axis's orthogonal plane: below that,
+  // the rounding of the sines below could matter (1 / cos of the angle bounds its effect).
+  constexpr double kMinCosine = 1e-3;
+  double worst_sine2 = 0;
+  for (const Control& c : controls) {
+    const double dot = axis.dot(c.n);
+    if (!(dot > 0) || !(dot * dot > kMinCosine * kMinCosine * c.q)) return saturated_cone(axis);
+    worst_sine2 = std::max(worst_sine2, axis.cross(c.n).squaredNorm() / c.q);
+  }
+  // Rounding of the axis, the cross products, the quotients and asin: a few ulps each, over a
+  // cosine of at least kMinCosine.
+  constexpr double kRounding = 1e-10;
+  double theta = 0;
+  if (!controls.empty()) {
+    theta = std::asin(std::min(1.0, std::sqrt(worst_sine2))) +
+            std::asin(std::min(1.0, std::sqrt(worst_ratio2))) + kRounding;
+  }
+  for (const NormalCone& c : cones) {
+    theta = std::max(theta, angle_between(axis, c.axis) + c.half_angle + kRounding);
+  }
+  return leaf_result(axis, theta);
+}
+
+}  // namespace detail
 
 }  // namespace clothcd

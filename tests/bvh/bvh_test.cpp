@@ -152,6 +152,88 @@ TEST(Bvh, RefitChangedEqualsFullRefitAfterEveryCall) {
   }
 }
 
+// With cone_min_triangles, the boxes are those of a plain refit, every node of at least that many
+// triangles (and every child such a node merges) has a cone holding its triangles' normals over
+// the step, and refit_moved() still gives the full refit's boxes and cones bit for bit.
+TEST(Bvh, ConeMinTrianglesConesHoldTheirNormalsAndRefitMovedMatches) {
+  int total_narrow = 0;  // cones below pi/2 checked
+  for (const auto& s : {crumpled_sheet(8, 7), twisted_strip(30, 3), stacked_sheets(6)}) {
+    const Topology topo(s.faces, s.num_vertices);
+    const auto v0 = points(s.v_t0);
+    for (const ConePolicy policy : {ConePolicy::Provot, ConePolicy::Proposed}) {
+      for (const int min : {2, 5, 16}) {
+        SCOPED_TRACE(::testing::Message() << s.name << " policy " << int(policy) << " min " << min);
+        auto v1 = points(s.v_t1);
+        RefitOptions ro;
+        ro.policy = policy;
+        ro.thickness = 1e-3;
+        Bvh plain(topo, v0, BvhBuild::Patch);
+        plain.refit(v0, v1, ro);
+        ro.cone_min_triangles = min;
+        Bvh flagged(topo, v0, BvhBuild::Patch);
+        auto last_v1 = v1;
+        for (int call = 0; call < 4; ++call) {
+          if (call > 0) {
+            for (std::size_t v = call; v < v1.size(); v += 11)
+              v1[v] += Eigen::Vector3d(0.002 * call, -0.001, 0.003);
+          }
+          std::vector<std::uint8_t> moved(v1.size(), 0);
+          for (std::size_t v = 0; v < v1.size(); ++v)
+            moved[v] = v1[v] != last_v1[v] ? 1 : 0;
+          last_v1 = v1;
+          flagged.refit_moved(v0, v1, ro, moved);
+          Bvh fresh(topo, v0, BvhBuild::Patch);
+          fresh.refit(v0, v1, ro);
+          const auto& nodes = fresh.nodes();
+          for (std::size_t i = 0; i < nodes.size(); ++i) {
+            for (int k = 0; k < 3; ++k) {
+              ASSERT_EQ(flagged.nodes()[i].lo[k], nodes[i].lo[k]) << "call " << call;
+              ASSERT_EQ(flagged.nodes()[i].hi[k], nodes[i].hi[k]) << "call " << call;
+              if (call == 0) {
+                ASSERT_EQ(plain.nodes()[i].lo[k], nodes[i].lo[k]);
+                ASSERT_EQ(plain.nodes()[i].hi[k], nodes[i].hi[k]);
+              }
+            }
+          }
+          int narrow = 0;
+          for (std::size_t i = 0; i < nodes.size(); ++i) {
+            const BvhNode& n = nodes[i];
+            if (n.count < min) continue;
+            // The node's cone and, for an internal node, the two it merged.
+            std::vector<std::size_t> with_cones{i};
+            if (!n.is_leaf()) with_cones = {i, std::size_t(n.left), std::size_t(n.left + 1)};
+            for (std::size_t j : with_cones) {
+              ASSERT_EQ(flagged.cones()[j].axis, fresh.cones()[j].axis) << "call " << call;
+              ASSERT_EQ(flagged.cones()[j].half_angle, fresh.cones()[j].half_angle);
+            }
+            const NormalCone& cone = fresh.cones()[i];
+            if (cone.saturated()) continue;
+            ++narrow;
+            for (int p = n.first; p < n.first + n.count; ++p) {
+              const Face& f = topo.faces()[fresh.prim_ids()[p]];
+              const BernsteinNormal b =
+                  bernstein_normal(v0[f[0]], v0[f[1]], v0[f[2]], v1[f[0]], v1[f[1]], v1[f[2]]);
+              for (int t = 0; t <= 8; ++t) {
+                ASSERT_TRUE(contains(cone, b.at(t / 8.0)))
+                    << "node " << i << " prim " << p << " t " << t << " call " << call;
+              }
+            }
+          }
+          // About as many usable cones as the policy's own (which the first call's `plain` has).
+          if (call == 0) {
+            int plain_narrow = 0;
+            for (std::size_t i = 0; i < nodes.size(); ++i)
+              plain_narrow += nodes[i].count >= min && !plain.cones()[i].saturated() ? 1 : 0;
+            EXPECT_GE(2 * narrow, plain_narrow);
+          }
+          total_narrow += narrow;
+        }
+      }
+    }
+  }
+  EXPECT_GT(total_narrow, 0);
+}
+
 // A Bvh owns what its refits read: built from a Topology that is then moved from and destroyed,
 // it (and a copy, and a moved tree) refits to the same boxes, cones and contours as a tree whose
 // Topology is still alive.

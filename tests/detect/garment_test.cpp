@@ -171,5 +171,52 @@ TEST(Garments, DressSoundWithThicknessAndReuseExact) {
   EXPECT_GT(culled, 0u);  // the cones were in the loop
 }
 
+// The simulator's cone threshold (DetectOptions::cull_min_triangles) on the dress with its CCD
+// thickness and reuse distance: under each policy, the same collisions as no culling and the same
+// proximity query after it, with cones refit and tested on the large nodes only.
+TEST(Garments, DressCullThresholdSameResults) {
+  CLOTHCD_REQUIRE_DATA(root, "garments/dress_knife/drape.obj");
+  const Garment g = load(root, 15656, 29456, 0.002);
+  const double reuse = 1e-3;
+  DetectOptions o;
+  o.thickness = 1e-5;
+  o.build = BvhBuild::Patch;
+  o.reuse_distance = reuse;
+  SelfDetector none(g.sewn.faces, g.sewn.num_vertices(), g.p0, o);
+  const DetectResult want = none.detect(g.p0, g.p1);
+  const ProximityResult want_near = none.proximity(g.p1, reuse);
+  ASSERT_GT(want.vf.size() + want.ee.size(), 0u);
+  for (ConePolicy policy : {ConePolicy::Provot, ConePolicy::Proposed}) {
+    std::uint64_t culled[2] = {0, 0};
+    for (const int min : {0, 16}) {
+      SCOPED_TRACE(::testing::Message() << "policy " << int(policy) << " min " << min);
+      DetectOptions c = o;
+      c.culling = Culling::Sound;
+      c.policy = policy;
+      c.cull_min_triangles = min;
+      SelfDetector det(g.sewn.faces, g.sewn.num_vertices(), g.p0, c);
+      const DetectResult r = det.detect(g.p0, g.p1);
+      EXPECT_EQ(r.vf, want.vf);
+      EXPECT_EQ(r.ee, want.ee);
+      culled[min > 0 ? 1 : 0] = r.stats.nodes_culled;
+      const ProximityResult p = det.proximity(g.p1, reuse);
+      ASSERT_EQ(p.vf.size(), want_near.vf.size());
+      ASSERT_EQ(p.ee.size(), want_near.ee.size());
+      for (std::size_t i = 0; i < p.vf.size(); ++i) {
+        EXPECT_EQ(p.vf[i].vertex, want_near.vf[i].vertex);
+        EXPECT_EQ(p.vf[i].face, want_near.vf[i].face);
+        EXPECT_EQ(p.vf[i].distance, want_near.vf[i].distance);
+      }
+      for (std::size_t i = 0; i < p.ee.size(); ++i) {
+        EXPECT_EQ(p.ee[i].edge_a, want_near.ee[i].edge_a);
+        EXPECT_EQ(p.ee[i].edge_b, want_near.ee[i].edge_b);
+        EXPECT_EQ(p.ee[i].distance, want_near.ee[i].distance);
+      }
+    }
+    EXPECT_GT(culled[0], 0u);
+    EXPECT_GT(culled[1], 0u);  // the large nodes still cull
+  }
+}
+
 }  // namespace
 }  // namespace clothcd

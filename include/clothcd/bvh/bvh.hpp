@@ -65,6 +65,12 @@ struct RefitOptions {
   /// cone of its descendant leaves' normal control directions (exact leaf caps). Slow: a node
   /// costs time linear in its triangles (clothcd/research/options.hpp).
   bool optimal_cones = false;
+  /// CCD refits with cones (and without optimal_cones) fit cones only to nodes of at least this
+  /// many triangles: such a node whose child is smaller gives that child a valid cone of its
+  /// triangles' normals computed at once (not `policy`'s), and the nodes below get none
+  /// (cones() keeps their last values). For a traversal that tests no smaller node's cone.
+  /// 0 or 1: every node gets `policy`'s cone. Static refits ignore it.
+  int cone_min_triangles = 0;
   bool operator==(const RefitOptions&) const = default;
 };
 
@@ -135,9 +141,9 @@ class Bvh {
   void refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options);
 
  private:
-  template <class LeafFn>
-  void refit_levels(const RefitOptions& options, std::span<const std::uint8_t> nodes,
-                    LeafFn&& leaf);
+  template <class LeafFn, class PatchFn>
+  void refit_levels(const RefitOptions& options, std::span<const std::uint8_t> nodes, int min_count,
+                    LeafFn&& leaf, PatchFn&& patch);
   // refit(v_t0, v_t1, options) of the flagged nodes only (all when `nodes` is empty; flags as
   // nodes_holding gives them); the others keep their last refit's box and cone.
   void refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,

@@ -52,6 +52,12 @@ struct DetectOptions {
   /// near the vertices whose position in v differs from theirs at t1 (all of them when over a
   /// quarter do).
   double reuse_distance = 0.0;
+  /// Culling::Sound tests only nodes of at least this many triangles, and the refit computes
+  /// cones for those only (RefitOptions::cone_min_triangles). A test on a smaller node can save
+  /// few pairs and costs about as much as it saves; skipping it is always sound, so the results
+  /// are the same at any value, only the culled-node counts change. 0: every node (the paper's
+  /// rule).
+  int cull_min_triangles = 0;
   /// Optional vertex pairs that count as one point (the two sides of a stitched seam): VF and EE
   /// pairs joining them are not tested, like pairs that share a vertex. Any order; duplicates
   /// allowed.
