@@ -51,6 +51,7 @@ struct NarrowBuffer {
   detail::FeatureCounters c;
   std::vector<VertexFaceCollision> vf;
   std::vector<EdgeEdgeCollision> ee;
+  detail::FeatureBatch batch;  // the pair loop's feature pairs, NP-filtered a batch at a time
 };
 
 }  // namespace
@@ -233,8 +234,12 @@ struct SelfDetector::Impl {
     const bool wide = box_reach() > opt.thickness;
     if (near != nullptr) near->assign(pairs.size(), 0);
     const auto& faces = topo.faces();
-    auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
-    auto kee = [&](int a, int b, NarrowBuffer& out) { ctx.kernel_ee(a, b, out.c, out.ee); };
+    auto kvf = [&](int v, int f, NarrowBuffer& out) {
+      ctx.queue_vf(v, f, out.batch, out.c, out.vf);
+    };
+    auto kee = [&](int a, int b, NarrowBuffer& out) {
+      ctx.queue_ee(a, b, out.batch, out.c, out.ee);
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         NarrowBuffer& out = locals.local();
@@ -261,6 +266,8 @@ struct SelfDetector::Impl {
                           triangle_pair(ctx, f, g, out, kvf, kee);
                         }
                       });
+    for (auto& l : locals)  // at most one partial batch of each kind per thread
+      ctx.flush(l.batch, l.c, l.vf, l.ee);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.vf.size(), 256),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         NarrowBuffer& out = locals.local();
