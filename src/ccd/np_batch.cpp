@@ -1,5 +1,7 @@
 #include "ccd/np_batch.hpp"
 
+// Without xsimd or off x86-64 (CLOTHCD_NP_BATCH_X86 unset) the batch runs the scalar filter.
+
 namespace clothcd::ccd_detail {
 
 #if CLOTHCD_NP_BATCH_X86
@@ -21,14 +23,12 @@ void np_filter_batch_scalar(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   }
 }
 
-bool has_avx2() {
 #if CLOTHCD_NP_BATCH_X86
+bool has_avx2() {
   static const bool yes = __builtin_cpu_supports("avx2") != 0;
   return yes;
-#else
-  return false;
-#endif
 }
+#endif
 
 }  // namespace
 

@@ -240,10 +240,33 @@ struct SelfDetector::Impl {
     auto kee = [&](int a, int b, NarrowBuffer& out) {
       ctx.queue_ee(a, b, out.batch, out.c, out.ee);
     };
+    // The pair loop waits on memory: a triangle pair's records sit at scattered places of the
+    // topology and box arrays. Fetch them ahead: the faces' own records kFar pairs ahead, the
+    // boxes of their vertices and edges (found through those records) kNear pairs ahead.
+    constexpr std::size_t kFar = 16, kNear = 8;
+    const auto fetch_face = [&](int f) {
+      detail::prefetch(&faces[f]);
+      detail::prefetch(&topo.face_edges(f));
+      detail::prefetch(&ctx.fboxes[f]);
+    };
+    const auto fetch_features = [&](int f) {
+      for (int k = 0; k < 3; ++k) {
+        detail::prefetch(&ctx.vboxes[faces[f][k]]);
+        detail::prefetch(&ctx.eboxes[topo.face_edges(f)[k]]);
+      }
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         NarrowBuffer& out = locals.local();
                         for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          if (i + kFar < pairs.size()) {
+                            fetch_face(pairs[i + kFar].first);
+                            fetch_face(pairs[i + kFar].second);
+                          }
+                          if (i + kNear < pairs.size()) {
+                            fetch_features(pairs[i + kNear].first);
+                            fetch_features(pairs[i + kNear].second);
+                          }
                           const auto [f, g] = pairs[i];
                           // Widened leaf boxes: no feature pair of faces whose own boxes miss.
                           if (wide && !detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) {

@@ -164,7 +164,7 @@ struct FeatureContext {
       kernel_vf(v, f, c, out);
       return;
     }
-    if (vf_linked(v, f)) return;
+    if (!links.empty() && vf_linked(v, f)) return;
     const Face& t = topo->faces()[f];
     b.vf_ids[b.vf.size] = {v, f};
     b.vf.push({v0[v].data(), v0[t[0]].data(), v0[t[1]].data(), v0[t[2]].data(), v1[v].data(),
@@ -178,7 +178,7 @@ struct FeatureContext {
       kernel_ee(ea, eb, c, out);
       return;
     }
-    if (ee_linked(ea, eb)) return;
+    if (!links.empty() && ee_linked(ea, eb)) return;
     const Edge& a = topo->edges()[ea];
     const Edge& d = topo->edges()[eb];
     b.ee_ids[b.ee.size] = {ea, eb};
@@ -415,6 +415,15 @@ class FeatureBoxes {
   std::uint64_t call_ = 0;  // the StepPositions call the boxes were computed at (0: none)
   double margin_ = -1.0;
 };
+
+/// A hint to fetch the cache line holding `p` (no effect on results).
+inline void prefetch(const void* p) {
+#if defined(__GNUC__)
+  __builtin_prefetch(p);
+#else
+  (void)p;
+#endif
+}
 
 /// Procedural R-triangle of (v, f): the first face of v, ascending, that shares no vertex with f
 /// (docs/algorithms.md 6.3); -1 when every face of v touches f (an orphan).
