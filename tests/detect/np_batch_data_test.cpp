@@ -131,11 +131,11 @@ TEST(NpBatchData, QueuedPairsGiveTheScalarResults) {
       std::vector<VertexFaceCollision> svf, qvf;
       std::vector<EdgeEdgeCollision> see, qee;
       detail::FeatureBatch batch;
-      for (const auto [v, face] : c.vf) {
+      for (const auto& [v, face] : c.vf) {
         ctx.kernel_vf(v, face, sc, svf);
         ctx.queue_vf(v, face, batch, qc, qvf);
       }
-      for (const auto [a, b] : c.ee) {
+      for (const auto& [a, b] : c.ee) {
         ctx.kernel_ee(a, b, sc, see);
         ctx.queue_ee(a, b, batch, qc, qee);
       }
