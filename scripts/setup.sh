@@ -9,7 +9,7 @@ set -euo pipefail
 profile=${1:-test}
 packages=(
   cmake g++ make pkg-config
-  libeigen3-dev libtbb-dev libfmt-dev libcli11-dev nlohmann-json3-dev
+  libeigen3-dev libtbb-dev libfmt-dev libcli11-dev nlohmann-json3-dev libxsimd-dev
 )
 case "$profile" in
   demo) ;;

@@ -16,6 +16,7 @@
 #include "ccd/fast_path.hpp"
 #include "ccd/inclusion.hpp"
 #include "ccd/motion.hpp"
+#include "ccd/np_batch.hpp"
 
 namespace clothcd {
 
@@ -50,11 +51,12 @@ CcdResult from(const ccd_detail::InclusionOutcome& o, CcdPath path, std::uint32_
   return r;
 }
 
-CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
-              const CcdOptions& opt) {
+// `np_kept`: the caller has found unscaled_np_filter's verdict Kept already.
+CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points, const CcdOptions& opt,
+              bool np_kept = false) {
   check_options(opt);
   // Most pairs of a detection step end here: the NP filter without building the scaled motion.
-  if (opt.fast_path && opt.thickness == 0 &&
+  if (opt.fast_path && opt.thickness == 0 && !np_kept &&
       ccd_detail::unscaled_np_filter(kind, points) == ccd_detail::NpVerdict::Culled) {
     CcdResult r;
     r.path = CcdPath::NpCulled;
@@ -113,6 +115,18 @@ CcdResult vertex_face_ccd(const VertexFaceQuery& q, const CcdOptions& opt) {
 CcdResult edge_edge_ccd(const EdgeEdgeQuery& q, const CcdOptions& opt) {
   return run(Kind::EdgeEdge, points_of(q), opt);
 }
+
+namespace ccd_detail {
+
+CcdResult vertex_face_ccd_np_kept(const VertexFaceQuery& q, const CcdOptions& opt) {
+  return run(Kind::VertexFace, points_of(q), opt, true);
+}
+
+CcdResult edge_edge_ccd_np_kept(const EdgeEdgeQuery& q, const CcdOptions& opt) {
+  return run(Kind::EdgeEdge, points_of(q), opt, true);
+}
+
+}  // namespace ccd_detail
 
 bool np_filter_culls(const VertexFaceQuery& q) {
   const auto verdict = ccd_detail::unscaled_np_filter(Kind::VertexFace, points_of(q));

@@ -54,6 +54,7 @@ struct NarrowBuffer {
   detail::FeatureCounters c;
   std::vector<VertexFaceCollision> vf;
   std::vector<EdgeEdgeCollision> ee;
+  detail::FeatureBatch batch;  // the pair loop's feature pairs, NP-filtered a batch at a time
 };
 
 }  // namespace
@@ -237,12 +238,39 @@ struct SelfDetector::Impl {
     const bool wide = box_reach() > opt.thickness;
     if (near != nullptr) near->assign(pairs.size(), 0);
     const auto& faces = topo.faces();
-    auto kvf = [&](int v, int f, NarrowBuffer& out) { ctx.kernel_vf(v, f, out.c, out.vf); };
-    auto kee = [&](int a, int b, NarrowBuffer& out) { ctx.kernel_ee(a, b, out.c, out.ee); };
+    auto kvf = [&](int v, int f, NarrowBuffer& out) {
+      ctx.queue_vf(v, f, out.batch, out.c, out.vf);
+    };
+    auto kee = [&](int a, int b, NarrowBuffer& out) {
+      ctx.queue_ee(a, b, out.batch, out.c, out.ee);
+    };
+    // The pair loop waits on memory: a triangle pair's records sit at scattered places of the
+    // topology and box arrays. Fetch them ahead: the faces' own records kFar pairs ahead, the
+    // boxes of their vertices and edges (found through those records) kNear pairs ahead.
+    constexpr std::size_t kFar = 16, kNear = 8;
+    const auto fetch_face = [&](int f) {
+      detail::prefetch(&faces[f]);
+      detail::prefetch(&topo.face_edges(f));
+      detail::prefetch(&ctx.fboxes[f]);
+    };
+    const auto fetch_features = [&](int f) {
+      for (int k = 0; k < 3; ++k) {
+        detail::prefetch(&ctx.vboxes[faces[f][k]]);
+        detail::prefetch(&ctx.eboxes[topo.face_edges(f)[k]]);
+      }
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         NarrowBuffer& out = locals.local();
                         for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          if (i + kFar < pairs.size()) {
+                            fetch_face(pairs[i + kFar].first);
+                            fetch_face(pairs[i + kFar].second);
+                          }
+                          if (i + kNear < pairs.size()) {
+                            fetch_features(pairs[i + kNear].first);
+                            fetch_features(pairs[i + kNear].second);
+                          }
                           const auto [f, g] = pairs[i];
                           // Widened leaf boxes: no feature pair of faces whose own boxes miss.
                           if (wide && !detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) {
@@ -265,6 +293,8 @@ struct SelfDetector::Impl {
                           triangle_pair(ctx, f, g, out, kvf, kee);
                         }
                       });
+    for (auto& l : locals)  // at most one partial batch of each kind per thread
+      ctx.flush(l.batch, l.c, l.vf, l.ee);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.vf.size(), 256),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         NarrowBuffer& out = locals.local();

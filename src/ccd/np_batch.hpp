@@ -1,0 +1,46 @@
+#pragma once
+// Internal: the NP filter (unscaled_np_filter) over a batch of queries of one kind held as a
+// structure of arrays, several queries per vector instruction. Each lane performs the same
+// floating-point operations in the same order as the scalar filter (no contraction, no
+// reassociation), so every verdict is the scalar one, bit for bit.
+
+#include <array>
+#include <cstdint>
+
+#include "ccd/cubic.hpp"
+#include "clothcd/ccd/queries.hpp"
+
+namespace clothcd::ccd_detail {
+
+/// Queries of one kind, gathered for np_filter_batch: coordinate c (0..2) of point p (0..7: the
+/// query's four points at t = 0, then at t = 1, in Kind's order) of query i is x[3 * p + c][i].
+struct NpBatch {
+  static constexpr int kCapacity = 128;  // a multiple of every vector width
+  double x[24][kCapacity] = {};
+  int size = 0;
+
+  [[nodiscard]] bool full() const { return size == kCapacity; }
+  /// Appends a query given by its 8 points (three doubles each).
+  void push(const std::array<const double*, 8>& points) {
+    for (int p = 0; p < 8; ++p) {
+      for (int c = 0; c < 3; ++c)
+        x[3 * p + c][size] = points[p][c];
+    }
+    ++size;
+  }
+};
+
+/// verdict[i] = unscaled_np_filter of query i of `b`, for i < b.size. Uses the widest vector
+/// instructions the processor has (AVX2 or the SSE2 baseline).
+void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict);
+
+/// The same with a fixed instruction set, for tests: 0 scalar (unscaled_np_filter per query),
+/// 1 SSE2, 2 AVX2. Returns false (and does nothing) when the processor lacks it.
+bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict);
+
+/// vertex_face_ccd and edge_edge_ccd for a query whose unscaled_np_filter verdict is known to be
+/// Kept: the same result, without running that filter again.
+CcdResult vertex_face_ccd_np_kept(const VertexFaceQuery& q, const CcdOptions& opt);
+CcdResult edge_edge_ccd_np_kept(const EdgeEdgeQuery& q, const CcdOptions& opt);
+
+}  // namespace clothcd::ccd_detail

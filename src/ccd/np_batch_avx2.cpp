@@ -1,0 +1,12 @@
+// np_filter_batch with AVX2 (compiled with -mavx2, without FMA; called only where the processor
+// has AVX2).
+#define NP_BATCH_NAMESPACE avx2_impl
+#include "ccd/np_batch_impl.hpp"
+
+namespace clothcd::ccd_detail {
+
+void np_filter_batch_avx2(Kind kind, const NpBatch& b, NpVerdict* verdict) {
+  avx2_impl::np_filter_batch_impl<xsimd::avx2>(kind, b, verdict);
+}
+
+}  // namespace clothcd::ccd_detail

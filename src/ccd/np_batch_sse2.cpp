@@ -1,0 +1,11 @@
+// np_filter_batch on the SSE2 baseline (every x86-64 processor).
+#define NP_BATCH_NAMESPACE sse2_impl
+#include "ccd/np_batch_impl.hpp"
+
+namespace clothcd::ccd_detail {
+
+void np_filter_batch_sse2(Kind kind, const NpBatch& b, NpVerdict* verdict) {
+  sse2_impl::np_filter_batch_impl<xsimd::sse2>(kind, b, verdict);
+}
+
+}  // namespace clothcd::ccd_detail

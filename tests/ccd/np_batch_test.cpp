@@ -1,0 +1,172 @@
+// The batched NP filter (SSE2, AVX2 and the dispatching entry) against the scalar filter,
+// unscaled_np_filter: the same verdict for every query, on seeded random queries over many scales,
+// near-coplanar and exactly coplanar ones, out-of-range magnitudes and non-finite coordinates;
+// and no culled query that the exact oracle finds in contact.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "ccd/np_batch.hpp"
+#include "exact_oracle.hpp"
+
+namespace clothcd::np_batch_test {
+namespace {
+
+using ccd_detail::Kind;
+using ccd_detail::NpBatch;
+using ccd_detail::NpVerdict;
+using V = Eigen::Vector3d;
+using Points = std::array<V, 8>;
+
+struct Gen {
+  std::mt19937_64 rng;
+  explicit Gen(std::uint64_t seed) : rng(seed) {}
+  double uniform(double lo, double hi) { return std::uniform_real_distribution<>(lo, hi)(rng); }
+  int integer(int lo, int hi) { return std::uniform_int_distribution<>(lo, hi)(rng); }
+  V vec(double s) { return V(uniform(-s, s), uniform(-s, s), uniform(-s, s)); }
+};
+
+// One query of family `family` (0..5).
+Points make_query(Gen& g, int family) {
+  Points p;
+  switch (family) {
+    case 0: {  // generic, log-uniform scale, including outside [2^-300, 2^100]
+      const double s = std::ldexp(1.0, g.integer(-340, 140));
+      const V shift = g.vec(4 * s);
+      for (auto& x : p)
+        x = shift + g.vec(s);
+      break;
+    }
+    case 1: {  // near-coplanar: all points close to the plane z = 0, small motion
+      const double s = std::ldexp(1.0, g.integer(-20, 20));
+      const double eps = std::ldexp(s, -g.integer(10, 60));
+      for (int i = 0; i < 4; ++i) {
+        p[i] = V(g.uniform(-s, s), g.uniform(-s, s), g.uniform(-eps, eps));
+        p[i + 4] = p[i] + V(g.uniform(-s, s) / 8, g.uniform(-s, s) / 8, g.uniform(-eps, eps));
+      }
+      break;
+    }
+    case 2: {  // small integer grid: exact coplanarity, zero coefficients, degenerate features
+      const double s = std::ldexp(1.0, g.integer(-10, 10));
+      for (auto& x : p)
+        x = V(g.integer(-2, 2), g.integer(-2, 2), g.integer(-1, 1)) * s;
+      if (g.integer(0, 1) == 0) {
+        for (int i = 0; i < 4; ++i)
+          p[i + 4] = p[i];
+      }
+      break;
+    }
+    case 3: {  // cloth-like: a small triangle and a nearby point or edge, sliding past
+      const double s = 0.01;
+      const V o = g.vec(1.0);
+      for (int i = 0; i < 4; ++i) {
+        p[i] = o + g.vec(s);
+        p[i + 4] = p[i] + g.vec(s / 4);
+      }
+      break;
+    }
+    case 4: {  // subnormal and tiny coordinates
+      const double s = std::ldexp(1.0, g.integer(-1074, -1000));
+      for (auto& x : p)
+        x = g.vec(s);
+      break;
+    }
+    default: {  // a non-finite or huge coordinate somewhere
+      for (auto& x : p)
+        x = g.vec(1.0);
+      const double bad[] = {std::numeric_limits<double>::infinity(),
+                            -std::numeric_limits<double>::infinity(),
+                            std::numeric_limits<double>::quiet_NaN(), 1e308, -1e308};
+      p[g.integer(0, 7)][g.integer(0, 2)] = bad[g.integer(0, 4)];
+      if (g.integer(0, 2) == 0) p[g.integer(0, 7)][g.integer(0, 2)] = bad[g.integer(0, 4)];
+      break;
+    }
+  }
+  return p;
+}
+
+void fill(NpBatch& b, const std::vector<Points>& qs) {
+  b.size = 0;
+  for (const Points& q : qs) {
+    b.push({q[0].data(), q[1].data(), q[2].data(), q[3].data(), q[4].data(), q[5].data(),
+            q[6].data(), q[7].data()});
+  }
+}
+
+// Every instruction set the processor has gives the scalar verdicts on `qs` (at most a batch).
+std::vector<NpVerdict> check_batch(Kind kind, const std::vector<Points>& qs) {
+  NpBatch b;
+  fill(b, qs);
+  std::vector<NpVerdict> expect(qs.size()), got(NpBatch::kCapacity);
+  EXPECT_TRUE(ccd_detail::np_filter_batch_with(0, kind, b, expect.data()));
+  for (int isa = 1; isa <= 3; ++isa) {
+    got.assign(got.size(), NpVerdict::Undecided);
+    if (isa < 3) {
+      if (!ccd_detail::np_filter_batch_with(isa, kind, b, got.data())) continue;
+    } else {
+      ccd_detail::np_filter_batch(kind, b, got.data());
+    }
+    for (std::size_t i = 0; i < qs.size(); ++i) {
+      EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " query " << i;
+    }
+  }
+  return expect;
+}
+
+VertexFaceQuery vf_query(const Points& p) {
+  return {p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]};
+}
+EdgeEdgeQuery ee_query(const Points& p) {
+  return {p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]};
+}
+
+TEST(NpBatch, MatchesTheScalarFilterOnRandomQueries) {
+  int culled = 0, kept = 0, undecided = 0;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    Gen g(seed);
+    for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
+      std::vector<Points> qs;
+      // Full batches and partial ones (every remainder of the vector widths).
+      const int n = seed % 2 == 0 ? NpBatch::kCapacity : g.integer(1, NpBatch::kCapacity);
+      for (int i = 0; i < n; ++i)
+        qs.push_back(make_query(g, g.integer(0, 5)));
+      for (const NpVerdict v : check_batch(kind, qs)) {
+        culled += v == NpVerdict::Culled;
+        kept += v == NpVerdict::Kept;
+        undecided += v == NpVerdict::Undecided;
+      }
+    }
+  }
+  // Every verdict occurs, so each lane path was compared.
+  EXPECT_GT(culled, 100);
+  EXPECT_GT(kept, 100);
+  EXPECT_GT(undecided, 100);
+}
+
+TEST(NpBatch, CullsNoQueryInContact) {
+  int culled = 0;
+  for (std::uint64_t seed = 100; seed < 106; ++seed) {
+    Gen g(seed);
+    for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
+      std::vector<Points> qs;
+      for (int i = 0; i < 64; ++i)
+        qs.push_back(make_query(g, g.integer(1, 3)));  // the families with contacts
+      const std::vector<NpVerdict> v = check_batch(kind, qs);
+      for (std::size_t i = 0; i < qs.size(); ++i) {
+        if (v[i] != NpVerdict::Culled) continue;
+        ++culled;
+        const bool contact = kind == Kind::VertexFace
+                                 ? test::exact_vertex_face_contact(vf_query(qs[i]))
+                                 : test::exact_edge_edge_contact(ee_query(qs[i]));
+        EXPECT_FALSE(contact) << "seed " << seed << " query " << i;
+      }
+    }
+  }
+  EXPECT_GT(culled, 50);
+}
+
+}  // namespace
+}  // namespace clothcd::np_batch_test

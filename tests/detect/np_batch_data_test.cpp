@@ -1,0 +1,165 @@
+// The batched NP filter on real queries, the candidate pairs of cloth_ball 92 -> 93: the same
+// verdict as the scalar filter from every instruction set, no culled pair among the ground-truth
+// collisions; and the narrow phase's queued path (FeatureContext::queue_vf, queue_ee, flush) gives
+// the scalar path's collisions, times of impact and counters under every filter setting.
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+#include "clothcd/mesh/io.hpp"
+#include "detect/narrow.hpp"
+#include "support/data.hpp"
+
+namespace clothcd::np_batch_data_test {
+namespace {
+
+nlohmann::json read_json(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+struct Candidates {
+  std::vector<std::pair<int, int>> vf, ee;  // (vertex, face), (edge, edge) with edge ids < ...
+  std::vector<bool> vf_truth, ee_truth;
+};
+
+Candidates candidates(const std::filesystem::path& root, int nv, int ne) {
+  Candidates c;
+  const auto vf = read_json(root / "boxes/92vf.json");
+  const auto ee = read_json(root / "boxes/92ee.json");
+  for (const auto& t : read_json(root / "mma_bool/92vf_mma_bool.json"))
+    c.vf_truth.push_back(t.get<bool>());
+  for (const auto& t : read_json(root / "mma_bool/92ee_mma_bool.json"))
+    c.ee_truth.push_back(t.get<bool>());
+  for (const auto& p : vf)
+    c.vf.emplace_back(p[0].get<int>(), p[1].get<int>() - nv - ne);
+  for (const auto& p : ee) {
+    const int a = p[0].get<int>() - nv, b = p[1].get<int>() - nv;
+    c.ee.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  return c;
+}
+
+struct Frames {
+  std::vector<Eigen::Vector3d> x0, x1;
+  Topology topo;
+};
+
+Frames frames(const std::filesystem::path& root) {
+  const TriangleMesh m0 = read_mesh(root / "frames/cloth_ball92.ply");
+  const TriangleMesh m1 = read_mesh(root / "frames/cloth_ball93.ply");
+  Frames f;
+  f.topo = Topology(m0.faces, m0.num_vertices());
+  for (int i = 0; i < m0.num_vertices(); ++i) {
+    f.x0.push_back(m0.vertices[i]);
+    f.x1.push_back(m1.vertices[i]);
+  }
+  return f;
+}
+
+// The candidates a batch at a time: every instruction set's verdicts against the scalar ones.
+template <class PointsOf>
+void compare_verdicts(ccd_detail::Kind kind, const std::vector<std::pair<int, int>>& pairs,
+                      const std::vector<bool>& truth, PointsOf&& points_of) {
+  using ccd_detail::NpVerdict;
+  ccd_detail::NpBatch b;
+  std::vector<NpVerdict> expect(ccd_detail::NpBatch::kCapacity), got(expect.size());
+  std::size_t culled = 0;
+  for (std::size_t start = 0; start < pairs.size(); start += ccd_detail::NpBatch::kCapacity) {
+    b.size = 0;
+    const std::size_t end = std::min(pairs.size(), start + ccd_detail::NpBatch::kCapacity);
+    for (std::size_t i = start; i < end; ++i)
+      b.push(points_of(pairs[i]));
+    ASSERT_TRUE(ccd_detail::np_filter_batch_with(0, kind, b, expect.data()));
+    for (int isa = 1; isa <= 2; ++isa) {
+      if (!ccd_detail::np_filter_batch_with(isa, kind, b, got.data())) continue;
+      for (int i = 0; i < b.size; ++i)
+        ASSERT_EQ(got[i], expect[i]) << "isa " << isa << " pair " << start + i;
+    }
+    for (int i = 0; i < b.size; ++i) {
+      if (expect[i] != NpVerdict::Culled) continue;
+      ++culled;
+      EXPECT_FALSE(truth[start + i]) << "a colliding pair culled: " << start + i;
+    }
+  }
+  EXPECT_GT(culled, 0u);
+}
+
+TEST(NpBatchData, ClothBallCandidatesMatchTheScalarFilter) {
+  CLOTHCD_REQUIRE_DATA(root, "cloth-ball");
+  const Frames f = frames(root);
+  const Candidates c = candidates(root, f.topo.num_vertices(), f.topo.num_edges());
+  ASSERT_EQ(c.vf.size(), c.vf_truth.size());
+  ASSERT_EQ(c.ee.size(), c.ee_truth.size());
+  compare_verdicts(ccd_detail::Kind::VertexFace, c.vf, c.vf_truth, [&](std::pair<int, int> p) {
+    const Face& t = f.topo.faces()[p.second];
+    const int v = p.first;
+    return std::array<const double*, 8>{f.x0[v].data(),    f.x0[t[0]].data(), f.x0[t[1]].data(),
+                                        f.x0[t[2]].data(), f.x1[v].data(),    f.x1[t[0]].data(),
+                                        f.x1[t[1]].data(), f.x1[t[2]].data()};
+  });
+  compare_verdicts(ccd_detail::Kind::EdgeEdge, c.ee, c.ee_truth, [&](std::pair<int, int> p) {
+    const Edge& a = f.topo.edges()[p.first];
+    const Edge& b = f.topo.edges()[p.second];
+    return std::array<const double*, 8>{f.x0[a[0]].data(), f.x0[a[1]].data(), f.x0[b[0]].data(),
+                                        f.x0[b[1]].data(), f.x1[a[0]].data(), f.x1[a[1]].data(),
+                                        f.x1[b[0]].data(), f.x1[b[1]].data()};
+  });
+}
+
+TEST(NpBatchData, QueuedPairsGiveTheScalarResults) {
+  CLOTHCD_REQUIRE_DATA(root, "cloth-ball");
+  const Frames f = frames(root);
+  const Candidates c = candidates(root, f.topo.num_vertices(), f.topo.num_edges());
+  // A few linked vertex pairs, so that the queue's link check is exercised too.
+  const std::vector<std::pair<int, int>> links = {
+      {c.vf[0].first, f.topo.faces()[c.vf[0].second][0]},
+      {f.topo.edges()[c.ee[1].first][0], f.topo.edges()[c.ee[1].second][1]}};
+  const auto sorted = detail::sorted_links(links, f.topo.num_vertices());
+  for (const bool np : {true, false}) {
+    for (const bool fast : {true, false}) {
+      if (!np && !fast) continue;  // the inclusion solver alone: slow, and nothing batched
+      SCOPED_TRACE(testing::Message() << "np_filter " << np << " fast_path " << fast);
+      DetectOptions o;
+      o.np_filter = np;
+      o.fast_path = fast;
+      const detail::FeatureContext ctx = detail::ccd_context(f.topo, f.x0, f.x1, o, sorted);
+      ASSERT_TRUE(ctx.batched_np());
+      detail::FeatureCounters sc, qc;
+      std::vector<VertexFaceCollision> svf, qvf;
+      std::vector<EdgeEdgeCollision> see, qee;
+      detail::FeatureBatch batch;
+      for (const auto& [v, face] : c.vf) {
+        ctx.kernel_vf(v, face, sc, svf);
+        ctx.queue_vf(v, face, batch, qc, qvf);
+      }
+      for (const auto& [a, b] : c.ee) {
+        ctx.kernel_ee(a, b, sc, see);
+        ctx.queue_ee(a, b, batch, qc, qee);
+      }
+      ctx.flush(batch, qc, qvf, qee);
+      EXPECT_EQ(qc.vf_tests, sc.vf_tests);
+      EXPECT_EQ(qc.ee_tests, sc.ee_tests);
+      EXPECT_EQ(qc.vf_np, sc.vf_np);
+      EXPECT_EQ(qc.ee_np, sc.ee_np);
+      ASSERT_EQ(qvf.size(), svf.size());
+      ASSERT_EQ(qee.size(), see.size());
+      // Same order: the queue keeps the order of the pairs.
+      for (std::size_t i = 0; i < svf.size(); ++i) {
+        EXPECT_EQ(qvf[i].vertex, svf[i].vertex);
+        EXPECT_EQ(qvf[i].face, svf[i].face);
+        EXPECT_EQ(qvf[i].toi, svf[i].toi);
+      }
+      for (std::size_t i = 0; i < see.size(); ++i) {
+        EXPECT_EQ(qee[i].edge_a, see[i].edge_a);
+        EXPECT_EQ(qee[i].edge_b, see[i].edge_b);
+        EXPECT_EQ(qee[i].toi, see[i].toi);
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace clothcd::np_batch_data_test
