@@ -71,10 +71,10 @@ TEST(Scene, ZoneMotionIsAffineUnlessTheSceneSaysRigid) {
   EXPECT_FALSE(parse_scene(j, "test-scene.json").contact.affine_zones);
 }
 
-TEST(Scene, SelfCcdCullsNothingUnlessTheSceneAsksForSoundCulling) {
+TEST(Scene, SelfCcdUsesSoundCullingUnlessTheSceneSaysNone) {
   json j = small_grid_scene();
   const Scene s = parse_scene(j, "test-scene.json");
-  EXPECT_EQ(s.contact.culling, Culling::None);
+  EXPECT_EQ(s.contact.culling, Culling::Sound);
   EXPECT_EQ(s.contact.cone_policy, ConePolicy::Proposed);
   j["collisions"] = {{"culling", "none"}, {"cone_policy", "provot"}};
   const Scene none = parse_scene(j, "test-scene.json");
