@@ -462,6 +462,7 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
         parse_culling(o.string("culling", std::string(to_string(c.culling)), {"none", "sound"}));
     c.cone_policy = parse_cone_policy(o.string("cone_policy", std::string(to_string(c.cone_policy)),
                                                {"provot", "proposed", "exact"}));
+    c.cull_min_triangles = o.integer("cull_min_triangles", c.cull_min_triangles);
     c.affine_zones = o.string("zone_motion", c.affine_zones ? "affine" : "rigid",
                               {"rigid", "affine"}) == "affine";
     s.repair_initial_crossings = o.boolean("repair_initial_crossings", s.repair_initial_crossings);

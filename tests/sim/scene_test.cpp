@@ -86,6 +86,13 @@ TEST(Scene, SelfCcdUsesSoundCullingUnlessTheSceneSaysNone) {
   EXPECT_EQ(exact.contact.cone_policy, ConePolicy::Exact);
   j["collisions"] = {{"cone_policy", "proposed"}};
   EXPECT_EQ(parse_scene(j, "test-scene.json").contact.cone_policy, ConePolicy::Proposed);
+  EXPECT_EQ(s.contact.cull_min_triangles, 16);
+  j["collisions"] = {{"cull_min_triangles", 0}};
+  EXPECT_EQ(parse_scene(j, "test-scene.json").contact.cull_min_triangles, 0);
+  j["collisions"] = {{"cull_min_triangles", -1}};
+  EXPECT_THROW((void)parse_scene(j, "test-scene.json"), InputError);
+  j["collisions"] = {{"cull_min_triangles", 2.5}};
+  EXPECT_THROW((void)parse_scene(j, "test-scene.json"), InputError);
 }
 
 TEST(Scene, UnresolvedHitsHalveTheSubstepUnlessTheSceneSaysNot) {

@@ -18,7 +18,8 @@ namespace {
 
 constexpr int kFrames = 4;
 
-Scene swinging_sheet(const std::string& culling, const std::string& policy) {
+Scene swinging_sheet(const std::string& culling, const std::string& policy,
+                     int cull_min_triangles = 16) {
   nlohmann::json j = nlohmann::json::parse(R"({"name": "swing", "frames": 4, "frame_dt": 0.04,
     "cloth": {"grid": {"origin": [-0.3, 0.22, -0.3], "u": [0.6, 0, 0], "v": [0, 0, 0.6],
                        "resolution": [24, 24]}},
@@ -27,6 +28,7 @@ Scene swinging_sheet(const std::string& culling, const std::string& policy) {
     "pins": [{"grid_edge": "u0"}]})");
   j["collisions"]["culling"] = culling;
   j["collisions"]["cone_policy"] = policy;
+  j["collisions"]["cull_min_triangles"] = cull_min_triangles;
   return parse_scene(j, "swing.json");
 }
 
@@ -39,8 +41,9 @@ struct Frames {
   std::vector<std::vector<Vec3>> x, v;
 };
 
-Frames run(const std::string& culling, const std::string& policy, int threads = 2) {
-  Simulation sim(swinging_sheet(culling, policy));
+Frames run(const std::string& culling, const std::string& policy, int threads = 2,
+           int cull_min_triangles = 16) {
+  Simulation sim(swinging_sheet(culling, policy, cull_min_triangles));
   Frames r;
   tbb::task_arena arena(threads);
   arena.execute([&] {
@@ -65,8 +68,10 @@ TEST(SelfCulling, EverySettingGivesTheSameFramesBitwise) {
     pairs_none += s.self_ccd.triangle_pairs;
   }
   EXPECT_GT(hits, 0);  // contact happened
-  for (const char* policy : {"provot", "proposed", "exact"}) {
-    const Frames sound = run("sound", policy);
+  // Every policy at the simulator's threshold, and PROPOSED testing every node.
+  for (const auto& [policy, threshold] : {std::pair{"provot", 16}, std::pair{"proposed", 16},
+                                          std::pair{"exact", 16}, std::pair{"proposed", 0}}) {
+    const Frames sound = run("sound", policy, 2, threshold);
     long long culled = 0, pairs = 0;
     for (int f = 0; f < kFrames; ++f) {
       const FrameStats &a = none.frames[f], &b = sound.frames[f];

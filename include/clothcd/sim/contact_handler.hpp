@@ -92,6 +92,10 @@ struct ContactOptions {
   /// The normal cones the sound culling uses (no effect without culling): Provot, Proposed or
   /// Exact. Again only the time and the figures change, never the motion.
   ConePolicy cone_policy = ConePolicy::Proposed;
+  /// The sound culling tests cones only on tree nodes of at least this many triangles
+  /// (DetectOptions::cull_min_triangles): a smaller node can save few pair tests and costs about
+  /// as much to test. Any value gives the same motion; 0 tests every node.
+  int cull_min_triangles = 16;
 };
 
 /// What the self detector's full CCD passes cost, summed over calls: the passes that test every

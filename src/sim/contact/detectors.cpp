@@ -19,8 +19,7 @@ SelfDetector& ContactDetectors::start_self(const ContactGeometry& g) {
     // Never the unsound cone rules in the simulator: None or Sound find the same pairs.
     o.culling = opt_.culling == Culling::None ? Culling::None : Culling::Sound;
     o.policy = opt_.cone_policy;
-    // Cone tests on small nodes cost about what they save (the results are the same either way).
-    o.cull_min_triangles = 16;
+    o.cull_min_triangles = opt_.cull_min_triangles;
     // The patch build: cones cull only nodes whose triangles form a disk, which median splits
     // rarely make, and its subtrees follow the surface, so the unculled traversal and the
     // proximity query are faster on it too (the pairs found are the same).
