@@ -18,10 +18,6 @@
 #include <type_traits>
 #include <vector>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include "ccd/face_bounds.hpp"
 #include "ccd/np_batch.hpp"
 #include "clothcd/bvh/aabb.hpp"
@@ -577,29 +573,6 @@ inline bool overlap(NoBoxes::Any, NoBoxes::Any) {
   return true;
 }
 
-/// overlap() of two feature boxes: on x86-64 its six comparisons as two SSE comparisons of three
-/// lanes each (the same float comparisons, so the same answers), half the instructions of the
-/// scalar test in the narrow phase's most frequent test.
-inline bool box_overlap(const Box& a, const Box& b) {
-#if defined(__SSE2__)
-  static_assert(sizeof(Box) == 6 * sizeof(float) && offsetof(Box, hi) == 3 * sizeof(float));
-  const auto* fa = reinterpret_cast<const float*>(&a);
-  const auto* fb = reinterpret_cast<const float*>(&b);
-  // Lanes: lo0 lo1 lo2 (hi0), and hi0 hi1 hi2 (hi2) from the four floats at offset 2.
-  const __m128 alo = _mm_loadu_ps(fa), blo = _mm_loadu_ps(fb);
-  const __m128 a2 = _mm_loadu_ps(fa + 2), b2 = _mm_loadu_ps(fb + 2);
-  const __m128 ahi = _mm_shuffle_ps(a2, a2, _MM_SHUFFLE(3, 3, 2, 1));
-  const __m128 bhi = _mm_shuffle_ps(b2, b2, _MM_SHUFFLE(3, 3, 2, 1));
-  const __m128 both = _mm_and_ps(_mm_cmple_ps(alo, bhi), _mm_cmple_ps(blo, ahi));
-  return (_mm_movemask_ps(both) & 7) == 7;
-#else
-  return overlap(a, b);
-#endif
-}
-inline bool box_overlap(NoBoxes::Any, NoBoxes::Any) {
-  return true;
-}
-
 /// The feature pairs of the triangle pair (f, g), sharing no vertex, whose R-triangle pair it is
 /// (docs/algorithms.md 6.3) and whose boxes overlap: vf(v, face) for a vertex of one face against
 /// the other, ee(e1, e2) with e1 < e2 for an edge of each. Box tests first (cheap, they reject
@@ -614,13 +587,13 @@ void owned_feature_pairs(const Topology& topo, const Ownership& owner, const Box
   const unsigned mf = owner.first_mask(f), mg = owner.first_mask(g);
   for (int k = 0; k < 3; ++k) {
     const int v = tf[k];
-    if (!box_overlap(boxes.vertex(v), bg)) continue;
+    if (!overlap(boxes.vertex(v), bg)) continue;
     if (!((mf >> k) & 1u) && !owner.owns_vf(v, g, f)) continue;
     vf(v, g);
   }
   for (int k = 0; k < 3; ++k) {
     const int v = tg[k];
-    if (!box_overlap(boxes.vertex(v), bf)) continue;
+    if (!overlap(boxes.vertex(v), bf)) continue;
     if (!((mg >> k) & 1u) && !owner.owns_vf(v, f, g)) continue;
     vf(v, f);
   }
@@ -630,9 +603,9 @@ void owned_feature_pairs(const Topology& topo, const Ownership& owner, const Box
   const B bg_edges[3] = {boxes.edge(eg[0]), boxes.edge(eg[1]), boxes.edge(eg[2])};
   for (int i = 0; i < 3; ++i) {
     const B& ba = boxes.edge(ef[i]);
-    if (!box_overlap(ba, bg)) continue;  // edge of f misses all of g
+    if (!overlap(ba, bg)) continue;  // edge of f misses all of g
     for (int j = 0; j < 3; ++j) {
-      if (!box_overlap(ba, bg_edges[j])) continue;
+      if (!overlap(ba, bg_edges[j])) continue;
       const int ea = ef[i], eb = eg[j];
       const bool a_first = ea < eb;
       const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;

@@ -154,18 +154,8 @@ TEST(Garments, DressSoundWithThicknessAndReuseExact) {
       const ProximityResult p = det.proximity(*at, reuse);
       const ProximityResult& want = at == &g.p1 ? ref_end : ref_shifted;
       EXPECT_GT(p.reused_pairs, 0u);
-      ASSERT_EQ(p.vf.size(), want.vf.size());
-      ASSERT_EQ(p.ee.size(), want.ee.size());
-      for (std::size_t i = 0; i < p.vf.size(); ++i) {
-        EXPECT_EQ(p.vf[i].vertex, want.vf[i].vertex);
-        EXPECT_EQ(p.vf[i].face, want.vf[i].face);
-        EXPECT_EQ(p.vf[i].distance, want.vf[i].distance);
-      }
-      for (std::size_t i = 0; i < p.ee.size(); ++i) {
-        EXPECT_EQ(p.ee[i].edge_a, want.ee[i].edge_a);
-        EXPECT_EQ(p.ee[i].edge_b, want.ee[i].edge_b);
-        EXPECT_EQ(p.ee[i].distance, want.ee[i].distance);
-      }
+      EXPECT_EQ(p.vf, want.vf);
+      EXPECT_EQ(p.ee, want.ee);
     }
   }
   EXPECT_GT(culled, 0u);  // the cones were in the loop
@@ -200,18 +190,8 @@ TEST(Garments, DressCullThresholdSameResults) {
       EXPECT_EQ(r.ee, want.ee);
       culled[min > 0 ? 1 : 0] = r.stats.nodes_culled;
       const ProximityResult p = det.proximity(g.p1, reuse);
-      ASSERT_EQ(p.vf.size(), want_near.vf.size());
-      ASSERT_EQ(p.ee.size(), want_near.ee.size());
-      for (std::size_t i = 0; i < p.vf.size(); ++i) {
-        EXPECT_EQ(p.vf[i].vertex, want_near.vf[i].vertex);
-        EXPECT_EQ(p.vf[i].face, want_near.vf[i].face);
-        EXPECT_EQ(p.vf[i].distance, want_near.vf[i].distance);
-      }
-      for (std::size_t i = 0; i < p.ee.size(); ++i) {
-        EXPECT_EQ(p.ee[i].edge_a, want_near.ee[i].edge_a);
-        EXPECT_EQ(p.ee[i].edge_b, want_near.ee[i].edge_b);
-        EXPECT_EQ(p.ee[i].distance, want_near.ee[i].distance);
-      }
+      EXPECT_EQ(p.vf, want_near.vf);
+      EXPECT_EQ(p.ee, want_near.ee);
     }
     EXPECT_GT(culled[0], 0u);
     EXPECT_GT(culled[1], 0u);  // the large nodes still cull

@@ -10,8 +10,13 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cstddef>
 #include <initializer_list>
 #include <limits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "clothcd/core/ulp.hpp"
 
@@ -38,6 +43,26 @@ template <class V>
 template <class T>
 [[nodiscard]] inline bool overlap(const Aabb<T>& a, const Aabb<T>& b) {
   return overlap(a.lo, a.hi, b.lo, b.hi);
+}
+/// The same test for feature boxes, the narrow phase's most frequent one: on x86-64 its six
+/// comparisons as two SSE comparisons of three lanes (the same float comparisons, so the same
+/// answers, NaN included), half the instructions of the scalar form.
+[[nodiscard]] inline bool overlap(const FeatureBox& a, const FeatureBox& b) {
+#if defined(__SSE2__)
+  static_assert(sizeof(FeatureBox) == 6 * sizeof(float) &&
+                offsetof(FeatureBox, hi) == 3 * sizeof(float));
+  const auto* fa = reinterpret_cast<const float*>(&a);
+  const auto* fb = reinterpret_cast<const float*>(&b);
+  // Lanes lo0 lo1 lo2 (hi0), and hi0 hi1 hi2 (hi2) shuffled from the four floats at offset 2.
+  const __m128 alo = _mm_loadu_ps(fa), blo = _mm_loadu_ps(fb);
+  const __m128 a2 = _mm_loadu_ps(fa + 2), b2 = _mm_loadu_ps(fb + 2);
+  const __m128 ahi = _mm_shuffle_ps(a2, a2, _MM_SHUFFLE(3, 3, 2, 1));
+  const __m128 bhi = _mm_shuffle_ps(b2, b2, _MM_SHUFFLE(3, 3, 2, 1));
+  const __m128 both = _mm_and_ps(_mm_cmple_ps(alo, bhi), _mm_cmple_ps(blo, ahi));
+  return (_mm_movemask_ps(both) & 7) == 7;
+#else
+  return overlap(a.lo, a.hi, b.lo, b.hi);
+#endif
 }
 
 /// Grows the double box [lo, hi] by `margin` on every side, rounded outwards (one ulp past the

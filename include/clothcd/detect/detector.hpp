@@ -41,10 +41,12 @@ struct ProximityResult {
   struct VertexFace {
     int vertex, face;
     double distance;
+    friend bool operator==(const VertexFace&, const VertexFace&) = default;
   };
   struct EdgeEdge {
     int edge_a, edge_b;
     double distance;
+    friend bool operator==(const EdgeEdge&, const EdgeEdge&) = default;
   };
   std::vector<VertexFace> vf;  ///< sorted by (vertex, face)
   std::vector<EdgeEdge> ee;    ///< sorted by (edge_a, edge_b)
