@@ -11,6 +11,7 @@
 
 #include "ccd/np_batch.hpp"
 #include "exact_oracle.hpp"
+#include "support/random_gen.hpp"
 
 namespace clothcd::np_batch_test {
 namespace {
@@ -21,13 +22,7 @@ using ccd_detail::NpVerdict;
 using V = Eigen::Vector3d;
 using Points = std::array<V, 8>;
 
-struct Gen {
-  std::mt19937_64 rng;
-  explicit Gen(std::uint64_t seed) : rng(seed) {}
-  double uniform(double lo, double hi) { return std::uniform_real_distribution<>(lo, hi)(rng); }
-  int integer(int lo, int hi) { return std::uniform_int_distribution<>(lo, hi)(rng); }
-  V vec(double s) { return V(uniform(-s, s), uniform(-s, s), uniform(-s, s)); }
-};
+using test::Gen;
 
 // One query of family `family` (0..5).
 Points make_query(Gen& g, int family) {

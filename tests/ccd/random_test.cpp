@@ -10,6 +10,7 @@
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/ccd/queries.hpp"
 #include "exact_oracle.hpp"
+#include "support/random_gen.hpp"
 
 // Queries per seed and family: small for the unit label, larger in the `slow` build.
 #ifndef CLOTHCD_CCD_RANDOM_COUNT
@@ -23,16 +24,7 @@ constexpr int kCount = CLOTHCD_CCD_RANDOM_COUNT;
 
 using V = Eigen::Vector3d;
 
-struct Gen {
-  std::mt19937_64 rng;
-  explicit Gen(std::uint64_t seed) : rng(seed) {}
-  double uniform(double lo, double hi) { return std::uniform_real_distribution<>(lo, hi)(rng); }
-  int integer(int lo, int hi) { return std::uniform_int_distribution<>(lo, hi)(rng); }
-  V vec(double s) { return V(uniform(-s, s), uniform(-s, s), uniform(-s, s)); }
-  V grid(int k) { return V(integer(-k, k), integer(-k, k), integer(-k, k)); }
-  // Log-uniform scale in [2^-30, 2^30].
-  double scale() { return std::ldexp(1.0, integer(-30, 30)); }
-};
+using test::Gen;
 
 // 8 points: v/ea0, f0/ea1, f1/eb0, f2/eb1 at t0, then at t1.
 using Points = std::array<V, 8>;
