@@ -2,7 +2,8 @@
 # Regenerates docs/results/ in one command: simulates the scenes (scenes/*.json) into OUT/frames,
 # runs `clothcd experiment` over their CD calls (every cone policy x culling rule x BVH build,
 # OPTIMAL spread angles, a timing pass at 1 and 2 threads), the in-situ comparison inside the
-# simulator, and copies every table and figure to docs/results/. Each part's wall time and the
+# simulator (its per-substep figures also go into Tables 1 and 2), and copies every table and
+# figure to docs/results/. Each part's wall time and the
 # load average before and after it go to OUT/run_times.md (copied too).
 #
 #   scripts/results.sh OUT
@@ -14,14 +15,14 @@
 #   CLOTHCD_BIN       the clothcd binary (default: build/release/apps/clothcd, built if missing)
 #   THREADS           worker threads of the simulations and the counting pass (default 2)
 #   DRESS_EVERY       run every E-th CD call of the dress scenes (default 1: all 120)
-#   MULTI_EVERY       the same for the multilayer scenes (default 2)
+#   MULTI_EVERY       the same for the multilayer scenes (default 1)
 #   OTHER_EVERY       the same for sphere-drop and twist (default 1)
 #   EVERY_<scene>     the same for one scene, '-' written '_' (e.g. EVERY_dress_kick=4)
 #   OPTIMAL_EVERY     OPTIMAL spread angles on every K-th call run (default 1)
 #   TIMING_EVERY      timing pass on every T-th call run (default 20)
 #   TIMING_REPEATS    calls per configuration and thread count in the timing pass (default 3)
 #   TIMING_THREADS    thread counts of the timing pass (default "1 2")
-#   INSITU_FRAMES     frames per garment of the in-situ comparison (default 6; 0: skip it)
+#   INSITU_FRAMES     frames per garment of the in-situ comparison (default 40; 0: skip it)
 #   COPY              1: copy the outputs to docs/results/ (default 1)
 #   OTHERS            the recorded and procedural sequences (default: fold stacked_sheets
 #                     winding_strip crumpled_sheet twisted_strip cloth_ball)
@@ -44,13 +45,13 @@ CLOTHCD_DATA=$(cd "$CLOTHCD_DATA" && pwd) || {
 bin=${CLOTHCD_BIN:-$root/build/release/apps/clothcd}
 threads=${THREADS:-2}
 dress_every=${DRESS_EVERY:-1}
-multi_every=${MULTI_EVERY:-2}
+multi_every=${MULTI_EVERY:-1}
 other_every=${OTHER_EVERY:-1}
 optimal_every=${OPTIMAL_EVERY:-1}
 timing_every=${TIMING_EVERY:-20}
 timing_repeats=${TIMING_REPEATS:-3}
 read -r -a timing_threads <<<"${TIMING_THREADS:-1 2}"
-insitu_frames=${INSITU_FRAMES:-6}
+insitu_frames=${INSITU_FRAMES:-40}
 copy=${COPY:-1}
 simulate=${SIMULATE:-1}
 
@@ -128,13 +129,20 @@ common=(--out "$out" --threads "$threads" --optimal-every "$optimal_every"
 for s in "${specs[@]}"; do
   part "experiment ${s%%[@%]*}" "$bin" experiment --scene "$s" "${common[@]}" --no-plots
 done
+# The in-situ run goes first: the tables read its OUT/in_situ.csv (per-substep sections). Its
+# report is kept once it covers every garment with the frames asked for.
+if [[ $insitu_frames -gt 0 ]]; then
+  if grep -q '^- scenes: 4 of 4 done' "$out/in_situ.md" 2>/dev/null &&
+    grep -q -- "--frames $insitu_frames " "$out/in_situ.md"; then
+    part "in situ, $insitu_frames frames per garment" true
+  else
+    part "in situ, $insitu_frames frames per garment" "$bin" experiment --in-situ \
+      "$root"/scenes/{dress-rumba,multilayer-rumba,dress-kick,multilayer-kick}.json \
+      --frames "$insitu_frames" --threads "$threads" --out "$out/in_situ.md"
+  fi
+fi
 part "tables and figures" "$bin" experiment --scene "${specs[@]}" "${common[@]}"
 
-if [[ $insitu_frames -gt 0 ]]; then
-  part "in situ, $insitu_frames frames per garment" "$bin" experiment --in-situ \
-    "$root"/scenes/{dress-rumba,multilayer-rumba,dress-kick,multilayer-kick}.json \
-    --frames "$insitu_frames" --threads "$threads" --out "$out/in_situ.md"
-fi
 
 # What the simulations cost when they ran (also for frames an earlier run made): their manifests.
 /usr/bin/python3 - "$out/frames" "${scenes[@]}" >>"$times" <<'PY'

@@ -202,6 +202,24 @@ std::vector<TimingRow> read_timing_rows(const std::filesystem::path& csv) {
 
 namespace detail {
 
+std::map<std::pair<std::string, std::string>, InSituTotals> read_in_situ(
+    const std::filesystem::path& csv) {
+  const Table t(csv);
+  std::map<std::pair<std::string, std::string>, InSituTotals> out;
+  for (std::size_t r = 0; r < t.size(); ++r) {
+    InSituTotals& s = out[{t.text(r, "scene"), t.text(r, "setting")}];
+    ++s.frames;
+    s.substeps += t.number(r, "substeps");
+    s.calls += t.number(r, "self_ccd_calls");
+    s.triangle_pairs += t.number(r, "triangle_pairs");
+    s.nodes_culled += t.number(r, "nodes_culled");
+    s.refit_s += t.number(r, "refit_s");
+    s.traversal_s += t.number(r, "traversal_s");
+    s.narrow_s += t.number(r, "narrow_s");
+  }
+  return out;
+}
+
 std::string timing_rows_csv(const std::vector<TimingRow>& rows) {
   std::string out =
       "scene,step,build,culling,policy,threads,repeat,load1,ms_refit,ms_traverse,ms_narrow,"

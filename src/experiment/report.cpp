@@ -14,12 +14,16 @@
 
 #include "clothcd/core/atomic_file.hpp"
 #include "clothcd/experiment/experiment.hpp"
+#include "format.hpp"
 #include "records.hpp"
 
 namespace clothcd::experiment {
 namespace {
 
 namespace fs = std::filesystem;
+using detail::grouped;
+using detail::pct;
+using detail::reduction;
 
 // The paper's Table 1 (average triangle pair tests) and Table 2 (ms: BVH construction, CD,
 // total), PROVOT then PROPOSED.
@@ -35,28 +39,6 @@ constexpr PaperRow kPaper[] = {
     {"Onepiece 1", 20849, 50518.85, 39499.42, 3.96, 4.61, 18.01, 14.29, 21.97, 18.90},
     {"Onepiece 2", 61949, 165412.73, 122977.72, 11.93, 14.06, 62.69, 48.33, 74.62, 62.40},
 };
-
-std::string grouped(double v, int decimals = 0) {
-  if (std::isnan(v)) return "-";
-  std::string s = fmt::format("{:.{}f}", std::abs(v), decimals);
-  const auto dot = s.find('.');
-  std::string head = s.substr(0, dot), tail = dot == std::string::npos ? "" : s.substr(dot);
-  std::string out;
-  for (std::size_t i = 0; i < head.size(); ++i) {
-    if (i > 0 && (head.size() - i) % 3 == 0) out += ',';
-    out += head[i];
-  }
-  return (v < 0 ? "-" : "") + out + tail;
-}
-
-std::string pct(double v) {
-  return std::isnan(v) ? std::string("-") : fmt::format("{:+.1f}%", 100.0 * v);
-}
-
-// 1 - x / base, NaN when the base is zero.
-double reduction(double x, double base) {
-  return base > 0 ? 1.0 - x / base : std::nan("");
-}
 
 double mean(const std::vector<double>& v) {
   return v.empty() ? std::nan("") : std::accumulate(v.begin(), v.end(), 0.0) / double(v.size());
@@ -653,8 +635,15 @@ void write_reports(const std::vector<Sequence>& scenes, const ExperimentOptions&
                ? stamp_lines + text
                : text.substr(0, eol + 2) + stamp_lines + "\n" + text.substr(eol + 2);
   };
-  write_file_atomic(opt.out / "table1.md", stamped(table1(data, opt)));
-  write_file_atomic(opt.out / "table2.md", stamped(table2(data, opt)));
+  // The simulator's own per-substep figures, when an in-situ run wrote them beside the tables.
+  std::string pairs_in_situ, times_in_situ;
+  if (const fs::path csv = opt.out / "in_situ.csv"; fs::exists(csv)) {
+    const auto totals = detail::read_in_situ(csv);
+    pairs_in_situ = detail::in_situ_pairs_section(totals);
+    times_in_situ = detail::in_situ_times_section(totals);
+  }
+  write_file_atomic(opt.out / "table1.md", stamped(table1(data, opt) + pairs_in_situ));
+  write_file_atomic(opt.out / "table2.md", stamped(table2(data, opt) + times_in_situ));
   write_file_atomic(opt.out / "timing.md", stamped(timing_table(data, opt)));
   write_file_atomic(opt.out / "misses.md", stamped(misses(data, opt)));
   write_file_atomic(opt.out / "spread.md", stamped(spread_table(data, opt)));

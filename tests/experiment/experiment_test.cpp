@@ -1,5 +1,6 @@
 // The experiment harness on a tiny procedural sequence: one row per step x configuration, the
 // reference equal to the brute-force oracle, `sound` equal to the reference, resume, tables, plots.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -159,6 +160,55 @@ TEST(Experiment, RowsPerStepAndConfigurationSoundEqualsReference) {
   EXPECT_NE(mi.find("Summary: 0 sound configuration(s) with misses, 0 with extra pairs."),
             std::string::npos);
   EXPECT_EQ(read_step_rows(opt.out / "steps.csv").size(), rows.size());
+  fs::remove_all(opt.out);
+}
+
+// An in-situ run's per-frame CSV beside the tables adds the per-substep sections: pair tests and
+// CD ms per self-CCD call (sums over the frames / calls), PROPOSED against PROVOT and none.
+TEST(Experiment, InSituFiguresJoinTables1And2) {
+  const Sequence seq = folding_sheet(4, 2);
+  ExperimentOptions opt;
+  opt.out = temp_dir("in_situ");
+  opt.builds = {BvhBuild::Patch};
+  opt.optimal_every = 0;
+  run_sequence(seq, opt);
+  // Two frames per setting: 2 + 3 calls; pairs and seconds chosen so the per-call means are
+  // none 200, PROVOT 100, PROPOSED 75, EXACT 75 pairs and 10 / 8 / 6 / 6 ms.
+  std::string csv =
+      "scene,setting,frame,substeps,frame_s,collision_s,self_ccd_calls,triangle_pairs,"
+      "nodes_culled,refit_s,traversal_s,narrow_s,proximity_calls,proximity_reused_pairs,"
+      "proximity_pairs,proximity_s\n";
+  const std::map<std::string, std::pair<double, double>> per_call{
+      {"none", {200, 10}}, {"PROVOT", {100, 8}}, {"PROPOSED", {75, 6}}, {"EXACT", {75, 6}}};
+  for (const auto& [setting, v] : per_call) {
+    for (int frame = 1, calls = 2; frame <= 2; ++frame, ++calls) {
+      const double ms = v.second * calls;
+      csv += fmt::format("garment,{},{},{},1.0,0.5,{},{},7,{},{},{},{},0,0,0.0\n", setting, frame,
+                         calls, calls, v.first * calls, 1e-3 * ms / 4, 1e-3 * ms / 4, 1e-3 * ms / 2,
+                         calls);
+    }
+  }
+  std::ofstream(opt.out / "in_situ.csv") << csv;
+  write_reports({seq}, opt);
+  const std::string t1 = slurp(opt.out / "table1.md"), t2 = slurp(opt.out / "table2.md");
+  check_markdown_tables(t1);
+  check_markdown_tables(t2);
+  EXPECT_NE(t1.find("| garment | 2 | 5 | 200 | 100 | 75 | 75 | +25.0% | +62.5% |"),
+            std::string::npos)
+      << t1;
+  EXPECT_NE(t2.find("| garment | 2 | 5 | 10.00 | 8.00 | 6.00 | 6.00 | +25.0% | +40.0% |"),
+            std::string::npos)
+      << t2;
+
+  // A malformed file names itself and the line.
+  std::ofstream(opt.out / "in_situ.csv") << csv << "garment,none,3\n";
+  try {
+    write_reports({seq}, opt);
+    ADD_FAILURE() << "no error for a short row";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("in_situ.csv"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("10"), std::string::npos) << e.what();
+  }
   fs::remove_all(opt.out);
 }
 

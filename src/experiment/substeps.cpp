@@ -1,0 +1,89 @@
+// The per-substep sections of Tables 1 and 2: what the simulator's own self-CCD did under each
+// cone setting (`clothcd experiment --in-situ`), beside the frame-pair figures.
+#include <fmt/format.h>
+
+#include <array>
+#include <set>
+#include <string>
+
+#include "format.hpp"
+#include "records.hpp"
+
+namespace clothcd::experiment::detail {
+namespace {
+
+using Totals = std::map<std::pair<std::string, std::string>, InSituTotals>;
+constexpr std::array<const char*, 4> kSettings{"none", "PROVOT", "PROPOSED", "EXACT"};
+
+std::set<std::string> scenes(const Totals& t) {
+  std::set<std::string> out;
+  for (const auto& [key, value] : t)
+    out.insert(key.first);
+  return out;
+}
+
+const InSituTotals* find(const Totals& t, const std::string& scene, const char* setting) {
+  const auto it = t.find({scene, setting});
+  return it == t.end() || it->second.calls <= 0 ? nullptr : &it->second;
+}
+
+// One row per scene: `value` per call under each setting, then PROPOSED against PROVOT and none.
+template <class Value>
+std::string rows(const Totals& t, Value value, int decimals) {
+  std::string s;
+  for (const std::string& scene : scenes(t)) {
+    const InSituTotals* none = find(t, scene, "none");
+    const InSituTotals* provot = find(t, scene, "PROVOT");
+    const InSituTotals* proposed = find(t, scene, "PROPOSED");
+    const InSituTotals* any = none != nullptr ? none : provot;
+    if (any == nullptr) continue;
+    s += fmt::format("| {} | {} | {} |", scene, any->frames, grouped(any->calls));
+    for (const char* setting : kSettings) {
+      const InSituTotals* x = find(t, scene, setting);
+      s += fmt::format(" {} |", x != nullptr ? grouped(value(*x) / x->calls, decimals) : "-");
+    }
+    auto vs = [&](const InSituTotals* base) {
+      return proposed != nullptr && base != nullptr
+                 ? pct(reduction(value(*proposed) / proposed->calls, value(*base) / base->calls))
+                 : std::string("-");
+    };
+    s += fmt::format(" {} | {} |\n", vs(provot), vs(none));
+  }
+  return s;
+}
+
+constexpr const char* kHead =
+    "| scene | frames | self-CCD calls | none | PROVOT | PROPOSED | EXACT | PROPOSED vs PROVOT | "
+    "PROPOSED vs none |\n|---|---|---|---|---|---|---|---|---|\n";
+
+}  // namespace
+
+std::string in_situ_pairs_section(const Totals& totals) {
+  return "## Per simulation substep, inside the simulator\n\n"
+         "The paper counted per simulation step. These rows come from the in-situ run "
+         "(in_situ.md): the simulator's own full self-CCD passes, one per substep, with its "
+         "contact thickness, under `none` and under the `sound` rule with each policy; every "
+         "frame was checked identical across the settings. Triangle pair tests per call; "
+         "*vs* = 1 - PROPOSED / X (positive = fewer tests; paper: +25.5% vs PROVOT).\n\n" +
+         std::string(kHead) +
+         rows(
+             totals, [](const InSituTotals& x) { return x.triangle_pairs; }, 0) +
+         "\n";
+}
+
+std::string in_situ_times_section(const Totals& totals) {
+  return "## Per simulation substep, inside the simulator\n\n"
+         "From the in-situ run (in_situ.md): ms of CD per self-CCD call (refit + traversal + "
+         "narrow phase of the simulator's full passes, one per substep); each setting simulated "
+         "once, frame by frame in turn, so drift is shared but every figure is a single run "
+         "(in_situ.md gives the load). *vs* = 1 - PROPOSED / X (positive = faster; paper: "
+         "+18.2% vs PROVOT in total time).\n\n" +
+         std::string(kHead) +
+         rows(
+             totals,
+             [](const InSituTotals& x) { return 1e3 * (x.refit_s + x.traversal_s + x.narrow_s); },
+             2) +
+         "\n";
+}
+
+}  // namespace clothcd::experiment::detail
