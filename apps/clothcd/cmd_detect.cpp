@@ -39,6 +39,7 @@ struct Args {
   std::uint64_t seed = 1;
   int garment_vertices = -1;
   int threads = 0;
+  int cull_min_triangles = 0;
   bool verify = false, table = false, table_optimal = false;
 };
 
@@ -166,9 +167,11 @@ int run(const Args& a) {
   research::set_culling_rule(o, research::parse_culling_rule(a.culling, "--culling"));
   o.build = parse_bvh_build(a.bvh, "--bvh");
   if (!(a.thickness >= 0)) throw InputError("--thickness must be >= 0");
+  if (a.cull_min_triangles < 0) throw InputError("--cull-min-triangles must be >= 0");
   if (a.weld > 0 && a.sew > 0) throw InputError("give at most one of --weld and --sew");
   if (a.table && !a.json.empty()) throw InputError("--table writes no JSON; drop --json");
   o.thickness = a.thickness;
+  o.cull_min_triangles = a.cull_min_triangles;
   o.research.verify = a.verify;
   const auto [m0, m1] = load_frames(a);
 
@@ -275,6 +278,9 @@ const bool registered = clothcd::app::register_command(
       sub.add_option("--weld", a->weld, "weld vertices closer than this first (0: off)");
       sub.add_option("--sew", a->sew, "weld and conform T-junctions at this tolerance (0: off)");
       sub.add_option("--thickness", a->thickness, "contact distance (>= 0)");
+      sub.add_option("--cull-min-triangles", a->cull_min_triangles,
+                     "sound culling tests only nodes of at least this many triangles (0: all; "
+                     "same results, less work)");
       sub.add_option("--threads", a->threads, "worker threads (0: all)");
       sub.add_flag("--verify", a->verify, "also run culling none and report missed collisions");
       sub.add_flag("--table", a->table,

@@ -209,6 +209,22 @@ def test_options_round_trip_and_verify():
     assert det.detect(V0, V1).missed_vf is None
 
 
+def test_cull_min_triangles_changes_the_work_not_the_results():
+    F, V0, V1 = clothcd.procedural.crumpled_sheet(16, 3)
+    every = clothcd.SelfDetector(F, V0, culling="sound").detect(V0, V1)
+    det = clothcd.SelfDetector(F, V0, culling="sound", cull_min_triangles=16)
+    assert det.options["cull_min_triangles"] == 16
+    big = det.detect(V0, V1)
+    assert np.array_equal(big.vf, every.vf) and np.array_equal(big.vf_toi, every.vf_toi)
+    assert np.array_equal(big.ee, every.ee) and np.array_equal(big.ee_toi, every.ee_toi)
+    # Only nodes of 16 or more triangles are tested: fewer cone tests than at 0.
+    assert 0 < big.stats["cone_tests"] < every.stats["cone_tests"]
+    det.set_options(cull_min_triangles=0)
+    assert det.detect(V0, V1).stats["cone_tests"] == every.stats["cone_tests"]
+    with pytest.raises(ValueError, match="cull_min_triangles must be >= 0"):
+        det.set_options(cull_min_triangles=-1)
+
+
 def test_float32_and_lists_are_accepted():
     F, V0, V1 = clothcd.procedural.stacked_sheets(6)
     det = clothcd.SelfDetector(F.tolist(), V0.tolist())

@@ -186,6 +186,30 @@ TEST(CliDetect, ThicknessReportsTrianglePairsCulledWhole) {
   }
 }
 
+TEST(CliDetect, CullMinTrianglesSameCollisionsFewerConeTests) {
+  CliScratch dir;
+  write_step(dir);
+  std::vector<nlohmann::json> results;
+  for (const char* threshold : {"0", "16"}) {
+    const std::string out = std::string("min") + threshold + ".json";
+    const auto r = dir.run(std::string("detect --t0 t0.obj --t1 t1.obj --culling sound --bvh patch "
+                                       "--cull-min-triangles ") +
+                           threshold + " --json " + out);
+    ASSERT_EQ(r.code, 0) << r.err;
+    results.push_back(nlohmann::json::parse(CliScratch::slurp(dir / out)));
+  }
+  EXPECT_EQ(results[0]["vf"], results[1]["vf"]);
+  EXPECT_EQ(results[0]["ee"], results[1]["ee"]);
+  const auto tests0 = results[0]["stats"]["cone_tests"].get<std::uint64_t>();
+  const auto tests16 = results[1]["stats"]["cone_tests"].get<std::uint64_t>();
+  EXPECT_GT(tests16, 0u);
+  EXPECT_LT(tests16, tests0);
+  const auto bad = dir.run("detect --t0 t0.obj --t1 t1.obj --cull-min-triangles -1 --json x.json");
+  EXPECT_EQ(bad.code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--cull-min-triangles"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.json"));
+}
+
 TEST(CliCcdQueries, MalformedCsvWithJson) {
   CliScratch dir;
   // One query is 8 rows (4 points at t0 and t1) of "x_num,x_den,y_num,y_den,z_num,z_den,truth".
