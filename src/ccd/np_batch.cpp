@@ -1,5 +1,8 @@
 #include "ccd/np_batch.hpp"
 
+#include "ccd/certify.hpp"
+#include "ccd/fast_path.hpp"
+
 // Without xsimd or off x86-64 (CLOTHCD_NP_BATCH_X86 unset) the batch runs the scalar filter.
 
 namespace clothcd::ccd_detail {
@@ -7,6 +10,8 @@ namespace clothcd::ccd_detail {
 #if CLOTHCD_NP_BATCH_X86
 void np_filter_batch_sse2(Kind kind, const NpBatch& b, NpVerdict* verdict);
 void np_filter_batch_avx2(Kind kind, const NpBatch& b, NpVerdict* verdict);
+void fast_path_misses_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
+void fast_path_misses_avx2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
 #endif
 
 namespace {
@@ -20,6 +25,43 @@ void np_filter_batch_scalar(Kind kind, const NpBatch& b, NpVerdict* verdict) {
       points[k] = &p[k];
     }
     verdict[i] = unscaled_np_filter(kind, points);
+  }
+}
+
+// The kernel's own steps for one kept query, through fast_path_solve's inside tests at
+// kFirstInsideLevel (queries.cpp run, fast_path.cpp).
+bool fast_path_miss_scalar(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points) {
+  const Motion m = make_motion(points);
+  if (!(m.max_abs.maxCoeff() > 0)) return false;  // run() reports contact at t = 0
+  const BernsteinCubic c = coplanarity_cubic(kind, m);
+  if (np_culls(c)) return false;  // path NpCulled, not a miss
+  const double e = subdivision_error(c);
+  if (one_sign(c.k, e)) return true;
+  const InsideData data = inside_data(kind, m);
+  double h[2][4], q[4][4];
+  halve(c.k, h[0], h[1]);
+  halve(h[0], q[0], q[1]);
+  halve(h[1], q[2], q[3]);
+  for (int j = 0; j < 4; ++j) {
+    if (one_sign(h[j / 2], e) || one_sign(q[j], e)) continue;
+    double u = 0, v = 0;
+    if (inside_over(data, 0.25 * j, 0.25 * (j + 1), u, v) != Inside::No) return false;
+  }
+  return true;
+}
+
+void fast_path_misses_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
+  static_assert(kFirstInsideLevel == 2 && kFastPathBudget >= 7);
+  for (int i = 0; i < b.size; ++i) {
+    miss[i] = false;
+    if (verdict[i] != NpVerdict::Kept) continue;
+    Eigen::Vector3d p[8];
+    std::array<const Eigen::Vector3d*, 8> points;
+    for (int k = 0; k < 8; ++k) {
+      p[k] = {b.x[3 * k][i], b.x[3 * k + 1][i], b.x[3 * k + 2][i]};
+      points[k] = &p[k];
+    }
+    miss[i] = fast_path_miss_scalar(kind, points);
   }
 }
 
@@ -42,6 +84,38 @@ void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict) {
 #else
   np_filter_batch_scalar(kind, b, verdict);
 #endif
+}
+
+void fast_path_misses(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
+#if CLOTHCD_NP_BATCH_X86
+  if (has_avx2()) {
+    fast_path_misses_avx2(kind, b, verdict, miss);
+  } else {
+    fast_path_misses_sse2(kind, b, verdict, miss);
+  }
+#else
+  fast_path_misses_scalar(kind, b, verdict, miss);
+#endif
+}
+
+bool fast_path_misses_with(int isa, Kind kind, const NpBatch& b, const NpVerdict* verdict,
+                           bool* miss) {
+  switch (isa) {
+    case 0:
+      fast_path_misses_scalar(kind, b, verdict, miss);
+      return true;
+#if CLOTHCD_NP_BATCH_X86
+    case 1:
+      fast_path_misses_sse2(kind, b, verdict, miss);
+      return true;
+    case 2:
+      if (!has_avx2()) return false;
+      fast_path_misses_avx2(kind, b, verdict, miss);
+      return true;
+#endif
+    default:
+      return false;
+  }
 }
 
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict) {

@@ -9,4 +9,8 @@ void np_filter_batch_avx2(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   avx2_impl::np_filter_batch_impl<xsimd::avx2>(kind, b, verdict);
 }
 
+void fast_path_misses_avx2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
+  avx2_impl::fast_path_misses_impl<xsimd::avx2>(kind, b, verdict, miss);
+}
+
 }  // namespace clothcd::ccd_detail

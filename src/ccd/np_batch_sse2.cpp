@@ -8,4 +8,8 @@ void np_filter_batch_sse2(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   sse2_impl::np_filter_batch_impl<xsimd::sse2>(kind, b, verdict);
 }
 
+void fast_path_misses_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
+  sse2_impl::fast_path_misses_impl<xsimd::sse2>(kind, b, verdict, miss);
+}
+
 }  // namespace clothcd::ccd_detail
