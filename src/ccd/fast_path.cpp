@@ -10,7 +10,7 @@ namespace clothcd::ccd_detail {
 namespace {
 
 // Ranges still undecided at this depth (2^-10 of the step) go to the inclusion solver.
-constexpr int kMaxLevel = 10;
+constexpr int kMaxLevel = kFastPathMaxLevel;
 // Ranges examined (with the inside test) per query; past it the inclusion solver takes the rest of
 // the step. Bounds the cost of flat cubics (near-coplanar motion) whose sign is never certain.
 constexpr int kBudget = kFastPathBudget;

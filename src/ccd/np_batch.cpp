@@ -28,30 +28,35 @@ void np_filter_batch_scalar(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   }
 }
 
-// The kernel's own steps for one kept query, through fast_path_solve's inside tests at
-// kFirstInsideLevel (queries.cpp run, fast_path.cpp).
+// The kernel's own steps for one kept query (queries.cpp run, fast_path.cpp): whether every range
+// of fast_path_solve's search below `b` on [lo, hi] at `level` is dropped by kMissLevel.
+bool dropped(const InsideData& data, const double (&b)[4], double e, double lo, double hi,
+             int level) {
+  if (one_sign(b, e)) return true;
+  if (level >= kFirstInsideLevel) {
+    double u = 0, v = 0;
+    const Inside in = inside_over(data, lo, hi, u, v);
+    if (in == Inside::No) return true;
+    if (level == kMissLevel || (in == Inside::Yes && sign_change(b, e))) return false;
+  }
+  double l[4], r[4];
+  halve(b, l, r);
+  const double mid = (lo + hi) * 0.5;
+  return dropped(data, l, e, lo, mid, level + 1) && dropped(data, r, e, mid, hi, level + 1);
+}
+
 bool fast_path_miss_scalar(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points) {
   const Motion m = make_motion(points);
   if (!(m.max_abs.maxCoeff() > 0)) return false;  // run() reports contact at t = 0
   const BernsteinCubic c = coplanarity_cubic(kind, m);
   if (np_culls(c)) return false;  // path NpCulled, not a miss
-  const double e = subdivision_error(c);
-  if (one_sign(c.k, e)) return true;
-  const InsideData data = inside_data(kind, m);
-  double h[2][4], q[4][4];
-  halve(c.k, h[0], h[1]);
-  halve(h[0], q[0], q[1]);
-  halve(h[1], q[2], q[3]);
-  for (int j = 0; j < 4; ++j) {
-    if (one_sign(h[j / 2], e) || one_sign(q[j], e)) continue;
-    double u = 0, v = 0;
-    if (inside_over(data, 0.25 * j, 0.25 * (j + 1), u, v) != Inside::No) return false;
-  }
-  return true;
+  return dropped(inside_data(kind, m), c.k, subdivision_error(c), 0.0, 1.0, 0);
 }
 
 void fast_path_misses_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
-  static_assert(kFirstInsideLevel == 2 && kFastPathBudget >= 7);
+  // Every range the search examines by kMissLevel is within its budget, none at its last level.
+  static_assert(kFirstInsideLevel <= kMissLevel && kMissLevel < kFastPathMaxLevel);
+  static_assert((2 << kMissLevel) - 1 <= kFastPathBudget);
   for (int i = 0; i < b.size; ++i) {
     miss[i] = false;
     if (verdict[i] != NpVerdict::Kept) continue;

@@ -92,9 +92,6 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   using Mask = xsimd::batch_bool<double, Arch>;
   constexpr int W = static_cast<int>(B::size);
   static_assert(NpBatch::kCapacity % W == 0);
-  // The search below: halvings to the quarters of the step, whose 1 + 2 + 4 ranges stay within
-  // the budget.
-  static_assert(kFirstInsideLevel == 2 && kFastPathBudget >= 7);
   struct V {
     B x, y, z;
   };
@@ -210,14 +207,6 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
         xsimd::max(xsimd::max(xsimd::max(xsimd::abs(k[0]), xsimd::abs(k[1])), xsimd::abs(k[2])),
                    xsimd::abs(k[3]));
     const B e = eta + sub_scale * kmax;
-    B h[2][4], q[4][4];
-    halve(k, h[0], h[1]);
-    halve(h[0], q[0], q[1]);
-    halve(h[1], q[2], q[3]);
-    const Mask root_open = !one_sign(k, e);
-    Mask open[4];
-    for (int j = 0; j < 4; ++j)
-      open[j] = root_open && !one_sign(h[j / 2], e) && !one_sign(q[j], e);
     // inside_data and inside_over's bound.
     V d0[5], d1[5];
     B amax(0.0);
@@ -229,31 +218,94 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
     const B mm = amax * widen;
     const B ein = in_scale * (mm * mm) * (mm * mm) + in_floor;
     const auto below = [&](const I& g) { return g.m + g.r < -ein; };
-    // inside_over over [j / 4, (j + 1) / 4]: a function below -ein over the range (answer No).
-    const auto outside = [&](int j) {
-      const B lo(0.25 * j), hi(0.25 * (j + 1));
-      IV x[5];
-      for (int t = 0; t < 5; ++t) {
-        const auto at = [&](const B& p0, const B& p1) {
+    const auto above = [&](const I& g) { return g.m - g.r > ein; };
+    struct Verdict {
+      Mask no, yes;
+    };
+    // inside_over over [lo, hi] in the lanes `need`: No (a function below -ein), Yes (all above
+    // ein). As soon as every such lane is No the other functions cannot change that, and Yes
+    // matters only where the answer is not No: stop there.
+    const auto inside = [&](double lo_t, double hi_t, const Mask& need) {
+      const B lo(lo_t), hi(hi_t);
+      const auto at = [&](int t) {
+        const auto one = [&](const B& p0, const B& p1) {
           const B dx = p1 - p0;
           const B p = p0 + lo * dx, r = p0 + hi * dx;
           return I{(p + r) * half, xsimd::abs(r - p) * half};
         };
-        x[t] = IV{at(d0[t].x, d1[t].x), at(d0[t].y, d1[t].y), at(d0[t].z, d1[t].z)};
-      }
-      const IV nn = icross(x[0], x[1]);
+        return IV{one(d0[t].x, d1[t].x), one(d0[t].y, d1[t].y), one(d0[t].z, d1[t].z)};
+      };
+      Verdict v{Mask(false), Mask(true)};
+      const auto add = [&](const I& g) {
+        v.no = v.no || below(g);
+        v.yes = v.yes && above(g);
+        return xsimd::none(need && !v.no);
+      };
+      const IV x0 = at(0), x1 = at(1), x2 = at(2);
+      const IV nn = icross(x0, x1);
       if (kind == Kind::VertexFace) {
-        return below(idot(nn, icross(x[0], x[2]))) || below(idot(nn, icross(x[3], x[4]))) ||
-               below(idot(nn, icross(x[2], x[1])));
+        if (add(idot(nn, icross(x0, x2)))) return v;
+        const IV x3 = at(3), x4 = at(4);
+        if (add(idot(nn, icross(x3, x4)))) return v;
+        add(idot(nn, icross(x2, x1)));
+        return v;
       }
-      return below(idot(nn, icross(x[2], x[1]))) || below(idot(nn, icross(x[3], x[1]))) ||
-             below(idot(nn, icross(x[2], x[0]))) || below(idot(nn, icross(x[4], x[0])));
+      if (add(idot(nn, icross(x2, x1)))) return v;
+      const IV x3 = at(3);
+      if (add(idot(nn, icross(x3, x1)))) return v;
+      if (add(idot(nn, icross(x2, x0)))) return v;
+      add(idot(nn, icross(at(4), x0)));
+      return v;
     };
-    // A quarter open in no lane that the cubic leaves to the fast path costs nothing.
+    // fast_path_solve's search, level by level to kMissLevel: range j of a level spans
+    // [j, j + 1] / 2^level. The kernel visits every range whose parent it splits and drops it
+    // where the cubic keeps one sign on it; from kFirstInsideLevel on it drops it where the
+    // inside answer is No, reports a hit where it is Yes and the cubic changes sign, and splits it
+    // otherwise. A lane is a miss when no range is left open by kMissLevel: then the kernel's
+    // depth-first order visits the same ranges with the same answers (none a hit), at most
+    // 2^(kMissLevel + 1) - 1 of them, within its budget.
+    constexpr int kSlots = 1 << kMissLevel;
+    B coef[2][kSlots][4];  // this level's ranges and the next one's, alternately
+    Mask open[2][kSlots];
+    int now = 0;
     Mask missed = !np_culled;
-    for (int j = 0; j < 4; ++j) {
-      if (xsimd::none(missed && open[j])) continue;
-      missed = missed && (!open[j] || outside(j));
+    for (int c = 0; c < 4; ++c)
+      coef[0][0][c] = k[c];
+    open[0][0] = missed && !one_sign(k, e);
+    for (int level = 0; level <= kMissLevel; ++level) {
+      const int count = 1 << level;
+      B(&cur)[kSlots][4] = coef[now];
+      B(&nxt)[kSlots][4] = coef[1 - now];
+      const Mask* cur_open = open[now];
+      Mask* nxt_open = open[1 - now];
+      Mask any_open(false);
+      for (int j = 0; j < count; ++j) {
+        const Mask need = missed && cur_open[j];
+        if (level < kMissLevel) nxt_open[2 * j] = nxt_open[2 * j + 1] = Mask(false);
+        if (xsimd::none(need)) continue;
+        Mask split = need;
+        if (level >= kFirstInsideLevel) {
+          const double width = 1.0 / count;
+          const Verdict in = inside(width * j, width * (j + 1), need);
+          const Mask left = need && !in.no;
+          if (level == kMissLevel) {
+            missed = missed && !left;
+            continue;
+          }
+          const Mask change =
+              ((cur[j][0] > e) && (cur[j][3] < -e)) || ((cur[j][0] < -e) && (cur[j][3] > e));
+          missed = missed && !(left && in.yes && change);
+          split = left && missed;
+          if (xsimd::none(split)) continue;
+        }
+        halve(cur[j], nxt[2 * j], nxt[2 * j + 1]);
+        nxt_open[2 * j] = split && !one_sign(nxt[2 * j], e);
+        nxt_open[2 * j + 1] = split && !one_sign(nxt[2 * j + 1], e);
+        any_open = any_open || nxt_open[2 * j] || nxt_open[2 * j + 1];
+      }
+      // Done where every lane still missing has no range left (the others are settled).
+      if (level == kMissLevel || xsimd::none(missed && any_open)) break;
+      now = 1 - now;
     }
     bool m[W];
     missed.store_unaligned(m);
