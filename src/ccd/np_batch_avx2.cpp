@@ -1,5 +1,5 @@
-// np_filter_batch with AVX2 (compiled with -mavx2, without FMA; called only where the processor
-// has AVX2).
+// np_filter_batch and fast_path_misses with AVX2 (compiled with -mavx2, without FMA; called only
+// where the processor has AVX2).
 #define NP_BATCH_NAMESPACE avx2_impl
 #include "ccd/np_batch_impl.hpp"
 

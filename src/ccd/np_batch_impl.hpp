@@ -1,7 +1,8 @@
 #pragma once
-// Internal: the body of np_filter_batch for one xsimd architecture, included by one source file
-// per instruction set (each compiled with its own target flags and -ffp-contract=off). Every
-// lane repeats cubic_of and unscaled_np_filter (cubic.cpp) operation for operation.
+// Internal: the bodies of np_filter_batch and fast_path_misses for one xsimd architecture,
+// included by one source file per instruction set (each compiled with its own target flags and
+// -ffp-contract=off). Every lane repeats the scalar code (cubic_of and unscaled_np_filter in
+// cubic.cpp; the kernel's fast path) operation for operation.
 
 #include <xsimd/xsimd.hpp>
 
@@ -84,8 +85,8 @@ void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
 }
 
 // fast_path_misses (np_batch.hpp): lane by lane, the kernel's operations on a query the NP filter
-// kept, from make_motion's scaling to the inside tests of the quarters of the step, each as the
-// scalar code performs it (the sources named at each step).
+// kept, from make_motion's scaling to the inside tests of the search down to kMissLevel, each as
+// the scalar code performs it (the sources named at each step).
 template <class Arch>
 void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
   using B = xsimd::batch<double, Arch>;

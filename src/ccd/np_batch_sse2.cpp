@@ -1,4 +1,4 @@
-// np_filter_batch on the SSE2 baseline (every x86-64 processor).
+// np_filter_batch and fast_path_misses on the SSE2 baseline (every x86-64 processor).
 #define NP_BATCH_NAMESPACE sse2_impl
 #include "ccd/np_batch_impl.hpp"
 

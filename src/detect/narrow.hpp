@@ -245,9 +245,10 @@ struct FeatureContext {
     if (b.vf.size == 0) return;
     ccd_detail::np_filter_batch(ccd_detail::Kind::VertexFace, b.vf, b.verdict.data());
     const bool misses = ccd.fast_path;
-    if (misses)
+    if (misses) {
       ccd_detail::fast_path_misses(ccd_detail::Kind::VertexFace, b.vf, b.verdict.data(),
                                    b.miss.data());
+    }
     for (int i = 0; i < b.vf.size; ++i) {
       ++c.vf_tests;
       if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
@@ -269,9 +270,10 @@ struct FeatureContext {
     if (b.ee.size == 0) return;
     ccd_detail::np_filter_batch(ccd_detail::Kind::EdgeEdge, b.ee, b.verdict.data());
     const bool misses = ccd.fast_path;
-    if (misses)
+    if (misses) {
       ccd_detail::fast_path_misses(ccd_detail::Kind::EdgeEdge, b.ee, b.verdict.data(),
                                    b.miss.data());
+    }
     for (int i = 0; i < b.ee.size; ++i) {
       ++c.ee_tests;
       if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
