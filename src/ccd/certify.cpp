@@ -63,39 +63,6 @@ InsideData inside_data(Kind kind, const Motion& m) {
 }
 
 Inside inside_over(const InsideData& d, double lo, double hi, double& u, double& v) {
-  // Each difference moves linearly in t, so over [lo, hi] it lies between its values at the two
-  // ends: midpoint-radius of those.
-  IV x[5];
-  for (int k = 0; k < 5; ++k) {
-    I* comp[3] = {&x[k].x, &x[k].y, &x[k].z};
-    for (int c = 0; c < 3; ++c) {
-      const double dx = d.x1[k][c] - d.x0[k][c];
-      const double a = d.x0[k][c] + lo * dx, b = d.x0[k][c] + hi * dx;
-      *comp[c] = I{(a + b) * 0.5, std::abs(b - a) * 0.5};
-    }
-  }
-  I g[4];
-  int count;
-  if (d.kind == Kind::VertexFace) {
-    const IV n = cross(x[0], x[1]);
-    g[0] = dot(n, cross(x[0], x[2]));  // weight of c
-    g[1] = dot(n, cross(x[3], x[4]));  // weight of a
-    g[2] = dot(n, cross(x[2], x[1]));  // weight of b
-    count = 3;
-    const double sum = g[0].m + g[1].m + g[2].m;
-    u = sum != 0 ? g[2].m / sum : 0;
-    v = sum != 0 ? g[0].m / sum : 0;
-  } else {
-    const IV n = cross(x[0], x[1]);
-    g[0] = dot(n, cross(x[2], x[1]));  // u |n|^2
-    g[1] = dot(n, cross(x[3], x[1]));  // (1 - u) |n|^2
-    g[2] = dot(n, cross(x[2], x[0]));  // v |n|^2
-    g[3] = dot(n, cross(x[4], x[0]));  // (1 - v) |n|^2
-    count = 4;
-    const double su = g[0].m + g[1].m, sv = g[2].m + g[3].m;
-    u = su != 0 ? g[0].m / su : 0;
-    v = sv != 0 ? g[2].m / sv : 0;
-  }
   // Forward error bound (docs/ccd.md): with every level-1 interval within M = a_max (1 + 1e-12)
   // of 0, the computed interval misses the exact range by at most ~870 u M^4 (interpolation
   // 9 u M, cross products 64 u M^2, dot products of magnitude <= 12 M^4); 2048 leaves margin for
@@ -103,12 +70,50 @@ Inside inside_over(const InsideData& d, double lo, double hi, double& u, double&
   const double mm = d.a_max * (1 + 1e-12);
   const double e = 2048 * kUnitRoundoff * (mm * mm) * (mm * mm) +
                    16384 * std::numeric_limits<double>::denorm_min();
-  bool all_positive = true;
-  for (int i = 0; i < count; ++i) {
-    if (g[i].m + g[i].r < -e) return Inside::No;
-    all_positive = all_positive && g[i].m - g[i].r > e;
+  // Each difference moves linearly in t, so over [lo, hi] it lies between its values at the two
+  // ends: midpoint-radius of those.
+  const auto at = [&](int k) {
+    I c[3];
+    for (int a = 0; a < 3; ++a) {
+      const double dx = d.x1[k][a] - d.x0[k][a];
+      const double p = d.x0[k][a] + lo * dx, q = d.x0[k][a] + hi * dx;
+      c[a] = I{(p + q) * 0.5, std::abs(q - p) * 0.5};
+    }
+    return IV{c[0], c[1], c[2]};
+  };
+  // The answer is No as soon as one function is below -e over the range, whichever it is, so each
+  // is tested as soon as it is computed; the others (and u, v) are needed only otherwise.
+  const auto below = [&](const I& g) { return g.m + g.r < -e; };
+  const auto above = [&](const I& g) { return g.m - g.r > e; };
+  const IV x0 = at(0), x1 = at(1), x2 = at(2);
+  const IV n = cross(x0, x1);
+  if (d.kind == Kind::VertexFace) {
+    const I gc = dot(n, cross(x0, x2));  // weight of c
+    if (below(gc)) return Inside::No;
+    const IV x3 = at(3), x4 = at(4);
+    const I ga = dot(n, cross(x3, x4));  // weight of a
+    if (below(ga)) return Inside::No;
+    const I gb = dot(n, cross(x2, x1));  // weight of b
+    if (below(gb)) return Inside::No;
+    const double sum = gc.m + ga.m + gb.m;
+    u = sum != 0 ? gb.m / sum : 0;
+    v = sum != 0 ? gc.m / sum : 0;
+    return above(gc) && above(ga) && above(gb) ? Inside::Yes : Inside::Unknown;
   }
-  return all_positive ? Inside::Yes : Inside::Unknown;
+  const I gu = dot(n, cross(x2, x1));  // u |n|^2
+  if (below(gu)) return Inside::No;
+  const IV x3 = at(3);
+  const I gu1 = dot(n, cross(x3, x1));  // (1 - u) |n|^2
+  if (below(gu1)) return Inside::No;
+  const I gv = dot(n, cross(x2, x0));  // v |n|^2
+  if (below(gv)) return Inside::No;
+  const IV x4 = at(4);
+  const I gv1 = dot(n, cross(x4, x0));  // (1 - v) |n|^2
+  if (below(gv1)) return Inside::No;
+  const double su = gu.m + gu1.m, sv = gv.m + gv1.m;
+  u = su != 0 ? gu.m / su : 0;
+  v = sv != 0 ? gv.m / sv : 0;
+  return above(gu) && above(gu1) && above(gv) && above(gv1) ? Inside::Yes : Inside::Unknown;
 }
 
 }  // namespace clothcd::ccd_detail

@@ -28,9 +28,9 @@ InsideData inside_data(Kind kind, const Motion& m);
 
 enum class Inside { No, Yes, Unknown };
 
-/// Certain answer over t in [lo, hi] (dyadic bounds in [0, 1]) when it can be decided; `u`, `v`
-/// receive the contact parameters at the range's middle (VF: weights of f1 and f2; EE: positions
-/// along edge a and edge b), meaningful for `inside`.
+/// Certain answer over t in [lo, hi] (dyadic bounds in [0, 1]) when it can be decided; unless the
+/// answer is No, `u`, `v` receive the contact parameters at the range's middle (VF: weights of f1
+/// and f2; EE: positions along edge a and edge b), meaningful for Yes.
 Inside inside_over(const InsideData& d, double lo, double hi, double& u, double& v);
 
 }  // namespace clothcd::ccd_detail

@@ -10,14 +10,14 @@ namespace clothcd::ccd_detail {
 namespace {
 
 // Ranges still undecided at this depth (2^-10 of the step) go to the inclusion solver.
-constexpr int kMaxLevel = 10;
+constexpr int kMaxLevel = kFastPathMaxLevel;
 // Ranges examined (with the inside test) per query; past it the inclusion solver takes the rest of
 // the step. Bounds the cost of flat cubics (near-coplanar motion) whose sign is never certain.
-constexpr int kBudget = 48;
-// The inside test (~45 ns) starts at this depth: the cubic's own halving (~5 ns) first discards the
-// quarters of the step without a root. On cloth_ball 92 -> 93 this halves the inside tests
-// (7.7 M -> 4.4 M for 2.3 M queries); deeper starts cost more on near-coplanar (flat) cubics.
-constexpr int kFirstInsideLevel = 2;
+constexpr int kBudget = kFastPathBudget;
+// The inside test (~45 ns) starts at kFirstInsideLevel: the cubic's own halving (~5 ns) first
+// discards the quarters of the step without a root. On cloth_ball 92 -> 93 depth 2 halves the
+// inside tests (7.7 M -> 4.4 M for 2.3 M queries); deeper starts cost more on near-coplanar (flat)
+// cubics.
 // Subdivision error bounds hold to this depth.
 constexpr int kMaxRefine = 40;
 

@@ -19,6 +19,14 @@ struct FastOutcome {
   std::uint32_t boxes = 0;  ///< inclusion boxes spent on undecided ranges
 };
 
+/// The search examines a range with the inside test from this depth on (shallower ranges are
+/// only halved), and at most kFastPathBudget ranges per query (fast_path.cpp says why);
+/// fast_path_misses (np_batch.hpp) repeats the search down to a fixed depth.
+inline constexpr int kFirstInsideLevel = 2;
+inline constexpr int kFastPathBudget = 48;
+/// Ranges still undecided at this depth go to the inclusion solver.
+inline constexpr int kFastPathMaxLevel = 10;
+
 /// `p` gives the inclusion solver's settings (its time range is ignored); `c` is the query's
 /// coplanarity cubic (not NP-culled).
 FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,

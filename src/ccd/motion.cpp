@@ -1,6 +1,10 @@
 #include "ccd/motion.hpp"
 
+#include <algorithm>
+#include <bit>
+#include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -11,30 +15,47 @@ Motion make_motion(const std::array<const Eigen::Vector3d*, 8>& points) {
   double m = 0;
   for (int i = 0; i < 8; ++i) {
     const Eigen::Vector3d& p = *points[i];
-    if (!p.allFinite()) {
+    const double ax = std::abs(p.x()), ay = std::abs(p.y()), az = std::abs(p.z());
+    if (!(ax <= DBL_MAX && ay <= DBL_MAX && az <= DBL_MAX)) {  // NaN or infinite
       throw std::invalid_argument(
           fmt::format("CCD query point {} is not finite ({}, {}, {})", i, p.x(), p.y(), p.z()));
     }
-    m = std::max(m, p.cwiseAbs().maxCoeff());
+    m = std::max(m, std::max(std::max(ax, ay), az));
   }
   Motion out;
-  // 2^-e with m * 2^-e in [0.5, 1); m == 0 leaves the (all-zero) query as it is.
-  int e = 0;
-  if (m > 0) std::frexp(m, &e);
-  out.scale = std::ldexp(1.0, -e);
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
-  out.max_abs.setZero();
+  out.scale = inverse_binade(m);
+  // Plain per-coordinate loops (the same products, minima and maxima, in the same order, as
+  // vector expressions): this runs once for every query past the NP filter.
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double top[3] = {0, 0, 0};
   for (int k = 0; k < 4; ++k) {
-    out.x0[k] = *points[k] * out.scale;
-    out.x1[k] = *points[k + 4] * out.scale;
-    for (const Eigen::Vector3d* p : {&out.x0[k], &out.x1[k]}) {
-      lo = lo.cwiseMin(*p);
-      hi = hi.cwiseMax(*p);
-      out.max_abs = out.max_abs.cwiseMax(p->cwiseAbs());
+    for (int a = 0; a < 3; ++a) {
+      const double p = (*points[k])[a] * out.scale, q = (*points[k + 4])[a] * out.scale;
+      out.x0[k][a] = p;
+      out.x1[k][a] = q;
+      lo[a] = std::min(std::min(lo[a], p), q);
+      hi[a] = std::max(std::max(hi[a], p), q);
+      top[a] = std::max(std::max(top[a], std::abs(p)), std::abs(q));
     }
   }
-  out.extent = (hi - lo).maxCoeff();
+  out.max_abs = Eigen::Vector3d(top[0], top[1], top[2]);
+  out.extent = std::max(std::max(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
   return out;
+}
+
+double inverse_binade(double m) {
+  // frexp's exponent e (m = f 2^e, f in [0.5, 1)) read off the bits of a normal m, and 2^-e
+  // built from bits where it is normal; ldexp and frexp elsewhere.
+  int e = 0;
+  if (m >= DBL_MIN && m <= DBL_MAX) {
+    e = static_cast<int>(std::bit_cast<std::uint64_t>(m) >> 52) - 1022;
+  } else if (m > 0) {
+    std::frexp(m, &e);
+  }
+  if (-e >= DBL_MIN_EXP - 1 && -e <= DBL_MAX_EXP - 1) {
+    return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - e) << 52);
+  }
+  return std::ldexp(1.0, -e);
 }
 
 }  // namespace clothcd::ccd_detail

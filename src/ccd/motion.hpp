@@ -23,4 +23,8 @@ struct Motion {
 /// Builds the scaled motion; throws std::invalid_argument on NaN/inf coordinates.
 Motion make_motion(const std::array<const Eigen::Vector3d*, 8>& points);
 
+/// The scale make_motion applies for a largest |coordinate| m (finite, >= 0): 2^-e with m 2^-e in
+/// [0.5, 1) (std::frexp's e), 1 for m == 0.
+double inverse_binade(double m);
+
 }  // namespace clothcd::ccd_detail

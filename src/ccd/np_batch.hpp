@@ -38,6 +38,25 @@ void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict);
 /// 1 SSE2, 2 AVX2. Returns false (and does nothing) when the processor lacks it.
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict);
 
+/// The depth (ranges of 2^-kMissLevel of the step) to which fast_path_misses follows the search.
+inline constexpr int kMissLevel = 4;
+
+/// For each query i < b.size whose NP verdict[i] is Kept: miss[i] = true where the kernel at
+/// zero thickness with the fast path (vertex_face_ccd_np_kept, edge_edge_ccd_np_kept) reports no
+/// contact, with path FastPath, by depth kMissLevel of its search: the scaled cubic is not
+/// NP-culled, and every range the search examines by then is dropped, the cubic keeping one sign
+/// on it or the contact point provably outside the features over it (inside_over's No).
+/// miss[i] = false elsewhere: run the kernel.
+/// Each lane performs the kernel's own floating-point operations in its order (make_motion's
+/// scaling, coplanarity_cubic, np_culls, subdivision_error, halve, one_sign, inside_data,
+/// inside_over), so a miss is exactly the kernel's verdict.
+void fast_path_misses(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
+
+/// The same with a fixed instruction set, for tests: 0 scalar (the kernel's functions per
+/// query), 1 SSE2, 2 AVX2. Returns false (and does nothing) when the processor lacks it.
+bool fast_path_misses_with(int isa, Kind kind, const NpBatch& b, const NpVerdict* verdict,
+                           bool* miss);
+
 /// vertex_face_ccd and edge_edge_ccd for a query whose unscaled_np_filter verdict is known to be
 /// Kept: the same result, without running that filter again.
 CcdResult vertex_face_ccd_np_kept(const VertexFaceQuery& q, const CcdOptions& opt);

@@ -1,7 +1,8 @@
 #pragma once
-// Internal: the body of np_filter_batch for one xsimd architecture, included by one source file
-// per instruction set (each compiled with its own target flags and -ffp-contract=off). Every
-// lane repeats cubic_of and unscaled_np_filter (cubic.cpp) operation for operation.
+// Internal: the bodies of np_filter_batch and fast_path_misses for one xsimd architecture,
+// included by one source file per instruction set (each compiled with its own target flags and
+// -ffp-contract=off). Every lane repeats the scalar code (cubic_of and unscaled_np_filter in
+// cubic.cpp; the kernel's fast path) operation for operation.
 
 #include <xsimd/xsimd.hpp>
 
@@ -9,6 +10,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "ccd/fast_path.hpp"
+#include "ccd/motion.hpp"
 #include "ccd/np_batch.hpp"
 
 namespace clothcd::ccd_detail {
@@ -78,6 +81,237 @@ void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
     for (int l = 0; l < n; ++l) {
       verdict[i + l] = !d[l] ? NpVerdict::Undecided : (c[l] ? NpVerdict::Culled : NpVerdict::Kept);
     }
+  }
+}
+
+// fast_path_misses (np_batch.hpp): lane by lane, the kernel's operations on a query the NP filter
+// kept, from make_motion's scaling to the inside tests of the search down to kMissLevel, each as
+// the scalar code performs it (the sources named at each step).
+template <class Arch>
+void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
+  using B = xsimd::batch<double, Arch>;
+  using Mask = xsimd::batch_bool<double, Arch>;
+  constexpr int W = static_cast<int>(B::size);
+  static_assert(NpBatch::kCapacity % W == 0);
+  struct V {
+    B x, y, z;
+  };
+  struct I {  // certify.cpp's midpoint-radius interval
+    B m, r;
+  };
+  struct IV {
+    I x, y, z;
+  };
+  const int ia = kind == Kind::VertexFace ? 1 : 0;
+  const int ib = kind == Kind::VertexFace ? 2 : 1;
+  const int ic = kind == Kind::VertexFace ? 3 : 2;
+  const int iq = kind == Kind::VertexFace ? 0 : 3;
+  // inside_data's difference vectors (point index pairs).
+  static constexpr int kVf[5][2] = {{2, 1}, {3, 1}, {0, 1}, {3, 2}, {0, 2}};
+  static constexpr int kEe[5][2] = {{1, 0}, {3, 2}, {2, 0}, {1, 2}, {0, 3}};
+  const auto& idx = kind == Kind::VertexFace ? kVf : kEe;
+  constexpr double u = DBL_EPSILON / 2;
+  const B third(3.0), half(0.5);
+  const B eta_scale(256 * u), eta_floor(1024 * std::numeric_limits<double>::denorm_min());
+  const B sub_scale(128 * u);
+  const B in_scale(2048 * u), in_floor(16384 * std::numeric_limits<double>::denorm_min());
+  const B widen(1 + 1e-12);
+  const auto sub = [](const V& p, const V& q) { return V{p.x - q.x, p.y - q.y, p.z - q.z}; };
+  const auto cross = [](const V& p, const V& q) {
+    return V{p.y * q.z - p.z * q.y, p.z * q.x - p.x * q.z, p.x * q.y - p.y * q.x};
+  };
+  const auto dot = [](const V& p, const V& q) { return p.x * q.x + p.y * q.y + p.z * q.z; };
+  const auto max_abs = [](const V& p) {
+    return xsimd::max(xsimd::max(xsimd::abs(p.x), xsimd::abs(p.y)), xsimd::abs(p.z));
+  };
+  const auto imul = [](const I& p, const I& q) {
+    return I{p.m * q.m, xsimd::abs(p.m) * q.r + xsimd::abs(q.m) * p.r + p.r * q.r};
+  };
+  const auto isub = [](const I& p, const I& q) { return I{p.m - q.m, p.r + q.r}; };
+  const auto iadd = [](const I& p, const I& q) { return I{p.m + q.m, p.r + q.r}; };
+  const auto icross = [&](const IV& p, const IV& q) {
+    return IV{isub(imul(p.y, q.z), imul(p.z, q.y)), isub(imul(p.z, q.x), imul(p.x, q.z)),
+              isub(imul(p.x, q.y), imul(p.y, q.x))};
+  };
+  const auto idot = [&](const IV& p, const IV& q) {
+    return iadd(iadd(imul(p.x, q.x), imul(p.y, q.y)), imul(p.z, q.z));
+  };
+  // One sign over the range (cubic.hpp one_sign).
+  const auto one_sign = [](const B(&c)[4], const B& e) {
+    return ((c[0] > e) && (c[1] > e) && (c[2] > e) && (c[3] > e)) ||
+           ((c[0] < -e) && (c[1] < -e) && (c[2] < -e) && (c[3] < -e));
+  };
+  // cubic.hpp halve.
+  const auto halve = [&](const B(&c)[4], B(&l)[4], B(&r)[4]) {
+    const B b01 = (c[0] + c[1]) * half, b12 = (c[1] + c[2]) * half, b23 = (c[2] + c[3]) * half;
+    const B b012 = (b01 + b12) * half, b123 = (b12 + b23) * half;
+    const B mid = (b012 + b123) * half;
+    l[0] = c[0];
+    l[1] = b01;
+    l[2] = b012;
+    l[3] = mid;
+    r[0] = mid;
+    r[1] = b123;
+    r[2] = b23;
+    r[3] = c[3];
+  };
+  // The kept queries only, W at a time (a partial group repeats its last query).
+  int kept[NpBatch::kCapacity];
+  int nk = 0;
+  for (int i = 0; i < b.size; ++i) {
+    miss[i] = false;
+    if (verdict[i] == NpVerdict::Kept) kept[nk++] = i;
+  }
+  for (int s = 0; s < nk; s += W) {
+    const int n = nk - s < W ? nk - s : W;
+    alignas(64) double col[24][W];
+    for (int r = 0; r < 24; ++r) {
+      for (int l = 0; l < W; ++l)
+        col[r][l] = b.x[r][kept[s + (l < n ? l : n - 1)]];
+    }
+    // make_motion: the largest |coordinate| and its power-of-two scale (inverse_binade, per lane).
+    // Kept queries are finite with coordinate differences of at least 2^-300, so the largest
+    // |coordinate| is positive and run() goes on to the cubic.
+    B top(0.0);
+    for (int r = 0; r < 24; ++r)
+      top = xsimd::max(top, xsimd::abs(B::load_aligned(col[r])));
+    alignas(64) double lane_top[W], lane_scale[W];
+    top.store_aligned(lane_top);
+    for (int l = 0; l < W; ++l)
+      lane_scale[l] = inverse_binade(lane_top[l]);
+    const B scale = B::load_aligned(lane_scale);
+    V x0[4], x1[4];
+    for (int p = 0; p < 4; ++p) {
+      x0[p] = V{B::load_aligned(col[3 * p]) * scale, B::load_aligned(col[3 * p + 1]) * scale,
+                B::load_aligned(col[3 * p + 2]) * scale};
+      x1[p] = V{B::load_aligned(col[3 * p + 12]) * scale, B::load_aligned(col[3 * p + 13]) * scale,
+                B::load_aligned(col[3 * p + 14]) * scale};
+    }
+    // coplanarity_cubic (cubic.cpp cubic_of) and np_culls.
+    const V e1_0 = sub(x0[ib], x0[ia]), e2_0 = sub(x0[ic], x0[ia]);
+    const V r0 = sub(x0[iq], x0[ia]);
+    const V e1_1 = sub(x1[ib], x1[ia]), e2_1 = sub(x1[ic], x1[ia]);
+    const V r1 = sub(x1[iq], x1[ia]);
+    const V n0 = cross(e1_0, e2_0), n1 = cross(e1_1, e2_1);
+    const V c01 = cross(e1_0, e2_1), c10 = cross(e1_1, e2_0);
+    const V nx2 = {c01.x + c10.x, c01.y + c10.y, c01.z + c10.z};
+    const B k[4] = {dot(n0, r0), (dot(nx2, r0) + dot(n0, r1)) / third,
+                    (dot(nx2, r1) + dot(n1, r0)) / third, dot(n1, r1)};
+    const B a = xsimd::max(xsimd::max(xsimd::max(max_abs(e1_0), max_abs(e2_0)),
+                                      xsimd::max(max_abs(r0), max_abs(e1_1))),
+                           xsimd::max(max_abs(e2_1), max_abs(r1)));
+    const B eta = eta_scale * (a * a * a) + eta_floor;
+    const Mask np_culled = one_sign(k, eta);
+    // fast_path_solve: subdivision_error, then the ranges down to the quarters of the step
+    // (kFirstInsideLevel), each dropped where the cubic keeps one sign on it or on its parent.
+    const B kmax =
+        xsimd::max(xsimd::max(xsimd::max(xsimd::abs(k[0]), xsimd::abs(k[1])), xsimd::abs(k[2])),
+                   xsimd::abs(k[3]));
+    const B e = eta + sub_scale * kmax;
+    // inside_data and inside_over's bound.
+    V d0[5], d1[5];
+    B amax(0.0);
+    for (int j = 0; j < 5; ++j) {
+      d0[j] = sub(x0[idx[j][0]], x0[idx[j][1]]);
+      d1[j] = sub(x1[idx[j][0]], x1[idx[j][1]]);
+      amax = xsimd::max(amax, xsimd::max(max_abs(d0[j]), max_abs(d1[j])));
+    }
+    const B mm = amax * widen;
+    const B ein = in_scale * (mm * mm) * (mm * mm) + in_floor;
+    const auto below = [&](const I& g) { return g.m + g.r < -ein; };
+    const auto above = [&](const I& g) { return g.m - g.r > ein; };
+    struct Verdict {
+      Mask no, yes;
+    };
+    // inside_over over [lo, hi] in the lanes `need`: No (a function below -ein), Yes (all above
+    // ein). As soon as every such lane is No the other functions cannot change that, and Yes
+    // matters only where the answer is not No: stop there.
+    const auto inside = [&](double lo_t, double hi_t, const Mask& need) {
+      const B lo(lo_t), hi(hi_t);
+      const auto at = [&](int t) {
+        const auto one = [&](const B& p0, const B& p1) {
+          const B dx = p1 - p0;
+          const B p = p0 + lo * dx, r = p0 + hi * dx;
+          return I{(p + r) * half, xsimd::abs(r - p) * half};
+        };
+        return IV{one(d0[t].x, d1[t].x), one(d0[t].y, d1[t].y), one(d0[t].z, d1[t].z)};
+      };
+      Verdict v{Mask(false), Mask(true)};
+      const auto add = [&](const I& g) {
+        v.no = v.no || below(g);
+        v.yes = v.yes && above(g);
+        return xsimd::none(need && !v.no);
+      };
+      const IV x0 = at(0), x1 = at(1), x2 = at(2);
+      const IV nn = icross(x0, x1);
+      if (kind == Kind::VertexFace) {
+        if (add(idot(nn, icross(x0, x2)))) return v;
+        const IV x3 = at(3), x4 = at(4);
+        if (add(idot(nn, icross(x3, x4)))) return v;
+        add(idot(nn, icross(x2, x1)));
+        return v;
+      }
+      if (add(idot(nn, icross(x2, x1)))) return v;
+      const IV x3 = at(3);
+      if (add(idot(nn, icross(x3, x1)))) return v;
+      if (add(idot(nn, icross(x2, x0)))) return v;
+      add(idot(nn, icross(at(4), x0)));
+      return v;
+    };
+    // fast_path_solve's search, level by level to kMissLevel: range j of a level spans
+    // [j, j + 1] / 2^level. The kernel visits every range whose parent it splits and drops it
+    // where the cubic keeps one sign on it; from kFirstInsideLevel on it drops it where the
+    // inside answer is No, reports a hit where it is Yes and the cubic changes sign, and splits it
+    // otherwise. A lane is a miss when no range is left open by kMissLevel: then the kernel's
+    // depth-first order visits the same ranges with the same answers (none a hit), at most
+    // 2^(kMissLevel + 1) - 1 of them, within its budget.
+    constexpr int kSlots = 1 << kMissLevel;
+    B coef[2][kSlots][4];  // this level's ranges and the next one's, alternately
+    Mask open[2][kSlots];
+    int now = 0;
+    Mask missed = !np_culled;
+    for (int c = 0; c < 4; ++c)
+      coef[0][0][c] = k[c];
+    open[0][0] = missed && !one_sign(k, e);
+    for (int level = 0; level <= kMissLevel; ++level) {
+      const int count = 1 << level;
+      B(&cur)[kSlots][4] = coef[now];
+      B(&nxt)[kSlots][4] = coef[1 - now];
+      const Mask* cur_open = open[now];
+      Mask* nxt_open = open[1 - now];
+      Mask any_open(false);
+      for (int j = 0; j < count; ++j) {
+        const Mask need = missed && cur_open[j];
+        if (level < kMissLevel) nxt_open[2 * j] = nxt_open[2 * j + 1] = Mask(false);
+        if (xsimd::none(need)) continue;
+        Mask split = need;
+        if (level >= kFirstInsideLevel) {
+          const double width = 1.0 / count;
+          const Verdict in = inside(width * j, width * (j + 1), need);
+          const Mask left = need && !in.no;
+          if (level == kMissLevel) {
+            missed = missed && !left;
+            continue;
+          }
+          const Mask change =
+              ((cur[j][0] > e) && (cur[j][3] < -e)) || ((cur[j][0] < -e) && (cur[j][3] > e));
+          missed = missed && !(left && in.yes && change);
+          split = left && missed;
+          if (xsimd::none(split)) continue;
+        }
+        halve(cur[j], nxt[2 * j], nxt[2 * j + 1]);
+        nxt_open[2 * j] = split && !one_sign(nxt[2 * j], e);
+        nxt_open[2 * j + 1] = split && !one_sign(nxt[2 * j + 1], e);
+        any_open = any_open || nxt_open[2 * j] || nxt_open[2 * j + 1];
+      }
+      // Done where every lane still missing has no range left (the others are settled).
+      if (level == kMissLevel || xsimd::none(missed && any_open)) break;
+      now = 1 - now;
+    }
+    bool m[W];
+    missed.store_unaligned(m);
+    for (int l = 0; l < n; ++l)
+      miss[kept[s + l]] = m[l];
   }
 }
 

@@ -1,4 +1,4 @@
-// np_filter_batch on the SSE2 baseline (every x86-64 processor).
+// np_filter_batch and fast_path_misses on the SSE2 baseline (every x86-64 processor).
 #define NP_BATCH_NAMESPACE sse2_impl
 #include "ccd/np_batch_impl.hpp"
 
@@ -6,6 +6,10 @@ namespace clothcd::ccd_detail {
 
 void np_filter_batch_sse2(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   sse2_impl::np_filter_batch_impl<xsimd::sse2>(kind, b, verdict);
+}
+
+void fast_path_misses_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
+  sse2_impl::fast_path_misses_impl<xsimd::sse2>(kind, b, verdict, miss);
 }
 
 }  // namespace clothcd::ccd_detail

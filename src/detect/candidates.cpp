@@ -60,11 +60,11 @@ void Candidates::append(int f, int g, FeaturePairs& out) const {
   }
   if (detail::share_vertex(im.topo.faces()[f], im.topo.faces()[g])) return;
   detail::owned_feature_pairs(
-      im.topo, im.owner, detail::NoBoxes{}, f, g,
-      [&](int v, int face) {
+      im.owner, detail::NoBoxes{}, f, g,
+      [&](int v, int face, const Face&) {
         if (!im.ctx.vf_linked(v, face)) out.vf.emplace_back(v, face);
       },
-      [&](int e1, int e2) {
+      [&](int e1, int e2, const Edge&, const Edge&) {
         if (!im.ctx.ee_linked(e1, e2)) out.ee.emplace_back(e1, e2);
       });
 }

@@ -238,25 +238,25 @@ struct SelfDetector::Impl {
     const bool wide = box_reach() > opt.thickness;
     if (near != nullptr) near->assign(pairs.size(), 0);
     const auto& faces = topo.faces();
-    auto kvf = [&](int v, int f, NarrowBuffer& out) {
-      ctx.queue_vf(v, f, out.batch, out.c, out.vf);
+    auto kvf = [&](int v, int f, const Face& t, NarrowBuffer& out) {
+      ctx.queue_vf(v, f, t, out.batch, out.c, out.vf);
     };
-    auto kee = [&](int a, int b, NarrowBuffer& out) {
-      ctx.queue_ee(a, b, out.batch, out.c, out.ee);
+    auto kee = [&](int a, int b, const Edge& ea, const Edge& eb, NarrowBuffer& out) {
+      ctx.queue_ee(a, b, ea, eb, out.batch, out.c, out.ee);
     };
     // The pair loop waits on memory: a triangle pair's records sit at scattered places of the
-    // topology and box arrays. Fetch them ahead: the faces' own records kFar pairs ahead, the
-    // boxes of their vertices and edges (found through those records) kNear pairs ahead.
+    // box arrays. Fetch them ahead: the faces' records and boxes kFar pairs ahead, the boxes of
+    // their vertices and edges (found through those records) kNear pairs ahead.
     constexpr std::size_t kFar = 16, kNear = 8;
     const auto fetch_face = [&](int f) {
-      detail::prefetch(&faces[f]);
-      detail::prefetch(&topo.face_edges(f));
+      detail::prefetch(&owner.record(f));
       detail::prefetch(&ctx.fboxes[f]);
     };
     const auto fetch_features = [&](int f) {
+      const detail::Ownership::FaceRecord& r = owner.record(f);
       for (int k = 0; k < 3; ++k) {
-        detail::prefetch(&ctx.vboxes[faces[f][k]]);
-        detail::prefetch(&ctx.eboxes[topo.face_edges(f)[k]]);
+        detail::prefetch(&ctx.vboxes[r.v[k]]);
+        detail::prefetch(&ctx.eboxes[r.e[k]]);
       }
     };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
@@ -337,12 +337,12 @@ struct SelfDetector::Impl {
   void triangle_pair(const detail::FeatureContext& ctx, int f, int g, Out& out, KernelVf&& kvf,
                      KernelEe&& kee) const {
     detail::owned_feature_pairs(
-        topo, owner, detail::StepBoxes{ctx}, f, g,
-        [&](int v, int face) {
-          if (vf_in_scope(v, face)) kvf(v, face, out);
+        owner, detail::StepBoxes{ctx}, f, g,
+        [&](int v, int face, const Face& t) {
+          if (vf_in_scope(v, face)) kvf(v, face, t, out);
         },
-        [&](int e1, int e2) {
-          if (ee_in_scope(e1, e2)) kee(e1, e2, out);
+        [&](int e1, int e2, const Edge& a, const Edge& b) {
+          if (ee_in_scope(e1, e2)) kee(e1, e2, a, b, out);
         });
   }
 
@@ -420,13 +420,11 @@ struct SelfDetector::Impl {
       std::vector<ProximityResult::EdgeEdge> ee;
     };
     tbb::enumerable_thread_specific<Buffer> locals;
-    auto kvf = [&](int v, int f, Buffer& out) {
-      const Face& t = topo.faces()[f];
+    auto kvf = [&](int v, int f, const Face& t, Buffer& out) {
       const double d = point_triangle_distance_if_within(v0[v], v0[t[0]], v0[t[1]], v0[t[2]], h);
       if (d <= h) out.vf.push_back({v, f, d});
     };
-    auto kee = [&](int a, int b, Buffer& out) {
-      const Edge &ea = topo.edges()[a], &eb = topo.edges()[b];
+    auto kee = [&](int a, int b, const Edge& ea, const Edge& eb, Buffer& out) {
       const double d = edge_edge_distance_if_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
       if (d <= h) out.ee.push_back({a, b, d});
     };
@@ -467,10 +465,14 @@ struct SelfDetector::Impl {
     }
     Buffer& out = locals.local();
     for (const auto& [v, f] : orphans.vf) {
-      if (vf_in_scope(v, f) && detail::overlap(ctx.vertex_box(v), ctx.face_box(f))) kvf(v, f, out);
+      if (vf_in_scope(v, f) && detail::overlap(ctx.vertex_box(v), ctx.face_box(f))) {
+        kvf(v, f, topo.faces()[f], out);
+      }
     }
     for (const auto& [a, b] : orphans.ee) {
-      if (ee_in_scope(a, b) && detail::overlap(ctx.edge_box(a), ctx.edge_box(b))) kee(a, b, out);
+      if (ee_in_scope(a, b) && detail::overlap(ctx.edge_box(a), ctx.edge_box(b))) {
+        kee(a, b, topo.edges()[a], topo.edges()[b], out);
+      }
     }
     ProximityResult res;
     res.reused_pairs = reused;

@@ -63,6 +63,7 @@ struct FeatureBatch {
   ccd_detail::NpBatch vf, ee;  // gathered positions
   std::array<std::pair<int, int>, kCapacity> vf_ids, ee_ids;
   std::array<ccd_detail::NpVerdict, kCapacity> verdict;
+  std::array<bool, kCapacity> miss;  // ccd_detail::fast_path_misses
 };
 
 /// Positions of one step and the test settings.
@@ -161,12 +162,16 @@ struct FeatureContext {
   /// settings, kernel_vf at once. `flush` tests what is left.
   void queue_vf(int v, int f, FeatureBatch& b, FeatureCounters& c,
                 std::vector<VertexFaceCollision>& out) const {
+    queue_vf(v, f, topo->faces()[f], b, c, out);
+  }
+  /// The same, given f's corners `t` (topo->faces()[f]).
+  void queue_vf(int v, int f, const Face& t, FeatureBatch& b, FeatureCounters& c,
+                std::vector<VertexFaceCollision>& out) const {
     if (!batched_np()) {
       kernel_vf(v, f, c, out);
       return;
     }
     if (!links.empty() && vf_linked(v, f)) return;
-    const Face& t = topo->faces()[f];
     b.vf_ids[b.vf.size] = {v, f};
     b.vf.push({v0[v].data(), v0[t[0]].data(), v0[t[1]].data(), v0[t[2]].data(), v1[v].data(),
                v1[t[0]].data(), v1[t[1]].data(), v1[t[2]].data()});
@@ -175,13 +180,16 @@ struct FeatureContext {
   /// kernel_ee deferred to a batch (as queue_vf).
   void queue_ee(int ea, int eb, FeatureBatch& b, FeatureCounters& c,
                 std::vector<EdgeEdgeCollision>& out) const {
+    queue_ee(ea, eb, topo->edges()[ea], topo->edges()[eb], b, c, out);
+  }
+  /// The same, given the edges' vertices `a` and `d` (topo->edges()[ea], [eb]).
+  void queue_ee(int ea, int eb, const Edge& a, const Edge& d, FeatureBatch& b, FeatureCounters& c,
+                std::vector<EdgeEdgeCollision>& out) const {
     if (!batched_np()) {
       kernel_ee(ea, eb, c, out);
       return;
     }
     if (!links.empty() && ee_linked(ea, eb)) return;
-    const Edge& a = topo->edges()[ea];
-    const Edge& d = topo->edges()[eb];
     b.ee_ids[b.ee.size] = {ea, eb};
     b.ee.push({v0[a[0]].data(), v0[a[1]].data(), v0[d[0]].data(), v0[d[1]].data(), v1[a[0]].data(),
                v1[a[1]].data(), v1[d[0]].data(), v1[d[1]].data()});
@@ -230,16 +238,24 @@ struct FeatureContext {
   }
 
   // A culled pair counts as culled by the NP filter where ccd_hit counts it so: always for the
-  // separate filter, with the fast path where the NP filter is on (counted_np).
+  // separate filter, with the fast path where the NP filter is on (counted_np). With the fast
+  // path (batched_np() implies zero thickness), the kept pairs that fast_path_misses settles are
+  // the kernel's misses on path FastPath: nothing to count, nothing to report.
   void flush_vf(FeatureBatch& b, FeatureCounters& c, std::vector<VertexFaceCollision>& out) const {
     if (b.vf.size == 0) return;
     ccd_detail::np_filter_batch(ccd_detail::Kind::VertexFace, b.vf, b.verdict.data());
+    const bool misses = ccd.fast_path;
+    if (misses) {
+      ccd_detail::fast_path_misses(ccd_detail::Kind::VertexFace, b.vf, b.verdict.data(),
+                                   b.miss.data());
+    }
     for (int i = 0; i < b.vf.size; ++i) {
       ++c.vf_tests;
       if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
         c.vf_np += np_filter ? 1 : 0;
         continue;
       }
+      if (misses && b.miss[i]) continue;  // the kernel's own answer: no contact, not NP-culled
       const auto [v, f] = b.vf_ids[i];
       const Face& t = topo->faces()[f];
       const VertexFaceQuery q{v0[v], v0[t[0]], v0[t[1]], v0[t[2]],
@@ -253,12 +269,18 @@ struct FeatureContext {
   void flush_ee(FeatureBatch& b, FeatureCounters& c, std::vector<EdgeEdgeCollision>& out) const {
     if (b.ee.size == 0) return;
     ccd_detail::np_filter_batch(ccd_detail::Kind::EdgeEdge, b.ee, b.verdict.data());
+    const bool misses = ccd.fast_path;
+    if (misses) {
+      ccd_detail::fast_path_misses(ccd_detail::Kind::EdgeEdge, b.ee, b.verdict.data(),
+                                   b.miss.data());
+    }
     for (int i = 0; i < b.ee.size; ++i) {
       ++c.ee_tests;
       if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
         c.ee_np += np_filter ? 1 : 0;
         continue;
       }
+      if (misses && b.miss[i]) continue;  // the kernel's own answer: no contact, not NP-culled
       const auto [ea, eb] = b.ee_ids[i];
       const Edge& a = topo->edges()[ea];
       const Edge& d = topo->edges()[eb];
@@ -468,23 +490,54 @@ class Ownership {
         r.t[i] = i < fs.size() ? topo.faces()[fs[i]] : Face{-1, -1, -1};
       }
     }
-    first_.resize(topo.num_faces());
+    records_.resize(topo.num_faces());
     for (int f = 0; f < topo.num_faces(); ++f) {
-      std::uint8_t m = 0;
+      FaceRecord& r = records_[f];
+      r.v = topo.faces()[f];
+      r.e = topo.face_edges(f);
+      r.first = 0;
       for (int k = 0; k < 3; ++k) {
-        if (topo.vertex_faces(topo.faces()[f][k])[0] == f) m |= 1u << k;
-        if (topo.edge_faces(topo.face_edges(f)[k])[0] == f) m |= 8u << k;
+        const int v = r.v[k];
+        const int h = topo.vertex_faces(v)[0];
+        if (h == f) r.first |= 1u << k;
+        int n = 0;
+        for (int x : topo.faces()[h]) {
+          if (x != v) r.other[k][n++] = x;
+        }
+        const int he = topo.edge_faces(r.e[k])[0];
+        if (he == f) r.first |= 8u << k;
+        const Edge& d = topo.edges()[r.e[k]];
+        for (int x : topo.faces()[he]) {
+          if (x != d[0] && x != d[1]) r.apex[k] = x;
+        }
       }
-      first_[f] = m;
     }
   }
 
-  /// Bit k (0..2): f is the first face of its corner k; bit 3 + k: f is the first face of its
-  /// edge face_edges(f)[k]. The first face of v owns (v, g) for every g it shares no vertex with,
-  /// and two first faces own their edges' pair (both loops below stop at their first step): in
-  /// a manifold mesh most features are tested by their first face, so one bit test replaces the
-  /// loops.
-  [[nodiscard]] std::uint8_t first_mask(int f) const { return first_[f]; }
+  /// One triangle's corners, edges and first-face data side by side (one cache line), so that the
+  /// pair loop reads one record per triangle and settles ownership from the two records alone
+  /// but for a few pairs (owned_feature_pairs).
+  struct alignas(64) FaceRecord {
+    Face v;                // corners
+    std::array<int, 3> e;  // face_edges: edge k joins corners k and (k + 1) % 3
+    // The two corners other than v[k] of v[k]'s first face.
+    int other[3][2];
+    // The corner off edge e[k] of that edge's first face.
+    int apex[3];
+    // Bit k (0..2): this face is the first face of corner k; bit 3 + k: the first face of edge
+    // e[k]. The first face of v owns (v, g) for every g it shares no vertex with, and two first
+    // faces own their edges' pair (both searches stop at their first step): in a manifold mesh
+    // most features are tested by their first face, so one bit test replaces the searches.
+    std::uint8_t first;
+
+    /// Edge e[k]'s vertices as Topology::edges() lists them (smaller id first).
+    [[nodiscard]] Edge edge(int k) const {
+      const int a = v[k], b = v[k == 2 ? 0 : k + 1];
+      return a < b ? Edge{a, b} : Edge{b, a};
+    }
+  };
+
+  [[nodiscard]] const FaceRecord& record(int f) const { return records_[f]; }
 
   /// Whether f (a face of v, sharing no vertex with g) is the R-triangle of (v, g): every face of
   /// v before it touches g.
@@ -548,8 +601,8 @@ class Ownership {
 
   const Face* faces_ = nullptr;
   std::vector<int> vf_off_, vf_ids_, ef_off_, ef_ids_;
-  std::vector<std::uint8_t> first_;
   std::vector<EdgeFaces> pair_;
+  std::vector<FaceRecord> records_;
 };
 
 /// A step's precomputed swept boxes (FeatureContext::vboxes, eboxes, fboxes) for
@@ -573,46 +626,75 @@ inline bool overlap(NoBoxes::Any, NoBoxes::Any) {
   return true;
 }
 
+/// Whether x is a corner of t.
+inline bool has_corner(const Face& t, int x) {
+  return x == t[0] || x == t[1] || x == t[2];
+}
+
 /// The feature pairs of the triangle pair (f, g), sharing no vertex, whose R-triangle pair it is
-/// (docs/algorithms.md 6.3) and whose boxes overlap: vf(v, face) for a vertex of one face against
-/// the other, ee(e1, e2) with e1 < e2 for an edge of each. Box tests first (cheap, they reject
-/// most), then ownership: a set bit of first_mask settles it, otherwise the ordered search.
+/// (docs/algorithms.md 6.3) and whose boxes overlap: vf(v, face, corners of face) for a vertex of
+/// one face against the other, ee(e1, e2, vertices of e1, vertices of e2) with e1 < e2 for an edge
+/// of each. Box tests first (cheap, they reject most), then ownership from the faces' records:
+/// a set bit of `first` settles it; otherwise the first candidate of the ordered search owns the
+/// pair, and it is not (f, g), unless that candidate touches the other face, and the records tell
+/// when it can:
+///  - VF (v of f, against g): the search starts at v's first face h, which is not f. h holds v,
+///    which g lacks, so h touches g exactly when one of h's other two corners is in g.
+///  - EE (edge a of f, edge b of g): the search starts at the edges' first faces ha = a + wa and
+///    hb = b + wb (wa, wb the apexes). a and b lie in f and g, which share no vertex, so ha and hb
+///    share one only if wb is in f, wa is in g or wa == wb. Where f is ha itself, wa is f's third
+///    corner (not in g) and the test is exactly "wb in f"; likewise for g.
+/// Only when the candidate may touch does the ordered search run (owns_vf, owns_ee).
 template <class Boxes, class Vf, class Ee>
-void owned_feature_pairs(const Topology& topo, const Ownership& owner, const Boxes& boxes, int f,
-                         int g, Vf&& vf, Ee&& ee) {
-  const Face& tf = topo.faces()[f];
-  const Face& tg = topo.faces()[g];
+void owned_feature_pairs(const Ownership& owner, const Boxes& boxes, int f, int g, Vf&& vf,
+                         Ee&& ee) {
+  const Ownership::FaceRecord& rf = owner.record(f);
+  const Ownership::FaceRecord& rg = owner.record(g);
   const auto& bf = boxes.face(f);
   const auto& bg = boxes.face(g);
-  const unsigned mf = owner.first_mask(f), mg = owner.first_mask(g);
+  const unsigned mf = rf.first, mg = rg.first;
   for (int k = 0; k < 3; ++k) {
-    const int v = tf[k];
+    const int v = rf.v[k];
     if (!overlap(boxes.vertex(v), bg)) continue;
-    if (!((mf >> k) & 1u) && !owner.owns_vf(v, g, f)) continue;
-    vf(v, g);
+    if (!((mf >> k) & 1u) &&
+        !((has_corner(rg.v, rf.other[k][0]) || has_corner(rg.v, rf.other[k][1])) &&
+          owner.owns_vf(v, g, f))) {
+      continue;
+    }
+    vf(v, g, rg.v);
   }
   for (int k = 0; k < 3; ++k) {
-    const int v = tg[k];
+    const int v = rg.v[k];
     if (!overlap(boxes.vertex(v), bf)) continue;
-    if (!((mg >> k) & 1u) && !owner.owns_vf(v, f, g)) continue;
-    vf(v, f);
+    if (!((mg >> k) & 1u) &&
+        !((has_corner(rf.v, rg.other[k][0]) || has_corner(rf.v, rg.other[k][1])) &&
+          owner.owns_vf(v, f, g))) {
+      continue;
+    }
+    vf(v, f, rf.v);
   }
-  const auto& ef = topo.face_edges(f);
-  const auto& eg = topo.face_edges(g);
   using B = std::decay_t<decltype(boxes.edge(0))>;
-  const B bg_edges[3] = {boxes.edge(eg[0]), boxes.edge(eg[1]), boxes.edge(eg[2])};
+  const B bg_edges[3] = {boxes.edge(rg.e[0]), boxes.edge(rg.e[1]), boxes.edge(rg.e[2])};
   for (int i = 0; i < 3; ++i) {
-    const B& ba = boxes.edge(ef[i]);
+    const B& ba = boxes.edge(rf.e[i]);
     if (!overlap(ba, bg)) continue;  // edge of f misses all of g
     for (int j = 0; j < 3; ++j) {
       if (!overlap(ba, bg_edges[j])) continue;
-      const int ea = ef[i], eb = eg[j];
+      const int ea = rf.e[i], eb = rg.e[j];
       const bool a_first = ea < eb;
       const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;
-      const bool mine = ((mf >> (3 + i)) & (mg >> (3 + j)) & 1u) ||
-                        (a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f));
+      bool mine = (mf >> (3 + i)) & (mg >> (3 + j)) & 1u;
+      if (!mine) {
+        const int wa = rf.apex[i], wb = rg.apex[j];
+        mine = (has_corner(rf.v, wb) || has_corner(rg.v, wa) || wa == wb) &&
+               (a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f));
+      }
       if (!mine) continue;
-      ee(e1, e2);
+      if (a_first) {
+        ee(e1, e2, rf.edge(i), rg.edge(j));
+      } else {
+        ee(e1, e2, rg.edge(j), rf.edge(i));
+      }
     }
   }
 }

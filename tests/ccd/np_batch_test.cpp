@@ -1,14 +1,20 @@
 // The batched NP filter (SSE2, AVX2 and the dispatching entry) against the scalar filter,
 // unscaled_np_filter: the same verdict for every query, on seeded random queries over many scales,
 // near-coplanar and exactly coplanar ones, out-of-range magnitudes and non-finite coordinates;
-// and no culled query that the exact oracle finds in contact.
+// and no culled query that the exact oracle finds in contact. Likewise fast_path_misses against
+// its scalar reference and the kernel, with no missed query in contact; and make_motion's scale
+// and coordinates against their definitions.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <vector>
 
+#include "ccd/motion.hpp"
 #include "ccd/np_batch.hpp"
 #include "exact_oracle.hpp"
 #include "support/random_gen.hpp"
@@ -161,6 +167,149 @@ TEST(NpBatch, CullsNoQueryInContact) {
     }
   }
   EXPECT_GT(culled, 50);
+}
+
+// fast_path_misses on `qs` (at most a batch) from every instruction set: the scalar reference's
+// answers, and each miss the kernel's own verdict (no hit, path FastPath). Returns the misses.
+std::vector<bool> check_misses(Kind kind, const std::vector<Points>& qs, int& kept) {
+  NpBatch b;
+  fill(b, qs);
+  std::vector<NpVerdict> verdict(NpBatch::kCapacity);
+  EXPECT_TRUE(ccd_detail::np_filter_batch_with(0, kind, b, verdict.data()));
+  bool expect[NpBatch::kCapacity], got[NpBatch::kCapacity];
+  EXPECT_TRUE(ccd_detail::fast_path_misses_with(0, kind, b, verdict.data(), expect));
+  for (int isa = 1; isa <= 3; ++isa) {
+    std::fill(std::begin(got), std::end(got), false);
+    if (isa < 3) {
+      if (!ccd_detail::fast_path_misses_with(isa, kind, b, verdict.data(), got)) continue;
+    } else {
+      ccd_detail::fast_path_misses(kind, b, verdict.data(), got);
+    }
+    for (std::size_t i = 0; i < qs.size(); ++i)
+      EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " query " << i;
+  }
+  std::vector<bool> out(qs.size());
+  CcdOptions opt;
+  opt.fast_path = true;
+  for (std::size_t i = 0; i < qs.size(); ++i) {
+    kept += verdict[i] == NpVerdict::Kept;
+    out[i] = expect[i];
+    if (!expect[i]) continue;
+    EXPECT_EQ(verdict[i], NpVerdict::Kept);
+    const CcdResult r = kind == Kind::VertexFace
+                            ? ccd_detail::vertex_face_ccd_np_kept(vf_query(qs[i]), opt)
+                            : ccd_detail::edge_edge_ccd_np_kept(ee_query(qs[i]), opt);
+    EXPECT_FALSE(r.hit) << "query " << i;
+    EXPECT_EQ(r.path, CcdPath::FastPath) << "query " << i;
+  }
+  return out;
+}
+
+TEST(FastPathMisses, MatchTheKernelOnRandomQueries) {
+  int kept = 0, missed = 0;
+  for (std::uint64_t seed = 200; seed < 240; ++seed) {
+    Gen g(seed);
+    for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
+      std::vector<Points> qs;
+      const int n = seed % 2 == 0 ? NpBatch::kCapacity : g.integer(1, NpBatch::kCapacity);
+      for (int i = 0; i < n; ++i)
+        qs.push_back(make_query(g, g.integer(0, 5)));
+      for (const bool m : check_misses(kind, qs, kept))
+        missed += m;
+    }
+  }
+  // Both answers occur among the kept queries, so each lane path was compared.
+  EXPECT_GT(missed, 100);
+  EXPECT_GT(kept - missed, 100);
+}
+
+TEST(FastPathMisses, MissNoQueryInContact) {
+  int kept = 0, missed = 0;
+  for (std::uint64_t seed = 300; seed < 306; ++seed) {
+    Gen g(seed);
+    for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
+      std::vector<Points> qs;
+      for (int i = 0; i < 64; ++i)
+        qs.push_back(make_query(g, g.integer(1, 3)));  // the families with contacts
+      const std::vector<bool> m = check_misses(kind, qs, kept);
+      for (std::size_t i = 0; i < qs.size(); ++i) {
+        if (!m[i]) continue;
+        ++missed;
+        const bool contact = kind == Kind::VertexFace
+                                 ? test::exact_vertex_face_contact(vf_query(qs[i]))
+                                 : test::exact_edge_edge_contact(ee_query(qs[i]));
+        EXPECT_FALSE(contact) << "seed " << seed << " query " << i;
+      }
+    }
+  }
+  EXPECT_GT(missed, 50);
+}
+
+// make_motion's scale: std::frexp's exponent, applied with std::ldexp, for every magnitude.
+TEST(FastPathMisses, InverseBinadeIsFrexpAndLdexp) {
+  Gen g(11);
+  std::vector<double> ms = {0.0,
+                            std::numeric_limits<double>::denorm_min(),
+                            std::numeric_limits<double>::min(),
+                            std::numeric_limits<double>::max(),
+                            0.5,
+                            1.0,
+                            std::nextafter(1.0, 0.0),
+                            0x1p-1022,
+                            0x1p-1023,
+                            0x1p1023};
+  for (int i = 0; i < 20000; ++i) {
+    const double m = std::ldexp(g.uniform(0.5, 1.0), g.integer(-1080, 1024));
+    if (std::isfinite(m)) ms.push_back(m);
+  }
+  for (const double m : ms) {
+    int e = 0;
+    if (m > 0) std::frexp(m, &e);
+    const double want = std::ldexp(1.0, -e);
+    EXPECT_EQ(ccd_detail::inverse_binade(m), want) << m;
+  }
+}
+
+// make_motion against its vector-expression form, coordinate for coordinate.
+TEST(FastPathMisses, MakeMotionMatchesItsVectorForm) {
+  for (std::uint64_t seed = 400; seed < 420; ++seed) {
+    Gen g(seed);
+    for (int i = 0; i < 200; ++i) {
+      Points p = make_query(g, g.integer(0, 4));
+      if (g.integer(0, 9) == 0) p[g.integer(0, 7)] = V::Zero();
+      std::array<const V*, 8> pts;
+      for (int k = 0; k < 8; ++k)
+        pts[k] = &p[k];
+      double m = 0;
+      for (const V& x : p)
+        m = std::max(m, x.cwiseAbs().maxCoeff());
+      int e = 0;
+      if (m > 0) std::frexp(m, &e);
+      const double scale = std::ldexp(1.0, -e);
+      V lo = V::Constant(INFINITY), hi = -lo, top = V::Zero();
+      const ccd_detail::Motion got = ccd_detail::make_motion(pts);
+      ASSERT_EQ(got.scale, scale);
+      for (int k = 0; k < 4; ++k) {
+        const V a = p[k] * scale, b = p[k + 4] * scale;
+        for (const V* x : {&a, &b}) {
+          lo = lo.cwiseMin(*x);
+          hi = hi.cwiseMax(*x);
+          top = top.cwiseMax(x->cwiseAbs());
+        }
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_EQ(std::bit_cast<std::uint64_t>(got.x0[k][c]), std::bit_cast<std::uint64_t>(a[c]));
+          EXPECT_EQ(std::bit_cast<std::uint64_t>(got.x1[k][c]), std::bit_cast<std::uint64_t>(b[c]));
+        }
+      }
+      // Equal, or both NaN (queries of subnormal magnitude below 2^-1023 scale by infinity).
+      const auto same = [](double a, double b) {
+        return a == b || (std::isnan(a) && std::isnan(b));
+      };
+      for (int c = 0; c < 3; ++c)
+        EXPECT_PRED2(same, got.max_abs[c], top[c]);
+      EXPECT_PRED2(same, got.extent, (hi - lo).maxCoeff());
+    }
+  }
 }
 
 }  // namespace
