@@ -29,11 +29,14 @@ bool np_culls(const BernsteinCubic& c);
 /// levels of de Casteljau halving (`halve`).
 double subdivision_error(const BernsteinCubic& c);
 
-/// De Casteljau halving of Bernstein coefficients on [lo, hi] into [lo, mid] and [mid, hi].
-inline void halve(const double (&b)[4], double (&left)[4], double (&right)[4]) {
-  const double b01 = (b[0] + b[1]) * 0.5, b12 = (b[1] + b[2]) * 0.5, b23 = (b[2] + b[3]) * 0.5;
-  const double b012 = (b01 + b12) * 0.5, b123 = (b12 + b23) * 0.5;
-  const double mid = (b012 + b123) * 0.5;
+/// De Casteljau halving of Bernstein coefficients on [lo, hi] into [lo, mid] and [mid, hi]. T is
+/// double or a batch of lanes (np_batch_impl.hpp), with the same operations in the same order.
+template <class T>
+inline void halve(const T (&b)[4], T (&left)[4], T (&right)[4]) {
+  const T half(0.5);
+  const T b01 = (b[0] + b[1]) * half, b12 = (b[1] + b[2]) * half, b23 = (b[2] + b[3]) * half;
+  const T b012 = (b01 + b12) * half, b123 = (b12 + b23) * half;
+  const T mid = (b012 + b123) * half;
   left[0] = b[0];
   left[1] = b01;
   left[2] = b012;
@@ -45,7 +48,9 @@ inline void halve(const double (&b)[4], double (&left)[4], double (&right)[4]) {
 }
 
 /// Every coefficient provably of one sign (error e): the cubic has no root on the range.
-inline bool one_sign(const double (&b)[4], double e) {
+/// T is double or a batch of lanes (then the answer is a mask).
+template <class T>
+inline auto one_sign(const T (&b)[4], const T& e) {
   return (b[0] > e && b[1] > e && b[2] > e && b[3] > e) ||
          (b[0] < -e && b[1] < -e && b[2] < -e && b[3] < -e);
 }

@@ -17,6 +17,29 @@
 namespace clothcd::ccd_detail {
 namespace NP_BATCH_NAMESPACE {
 
+// A 3-vector of lanes and the vector operations both routines share, each in the scalar code's
+// operation order (no FMA contraction in these files).
+template <class B>
+struct Vec3 {
+  B x, y, z;
+};
+template <class B>
+Vec3<B> sub(const Vec3<B>& p, const Vec3<B>& q) {
+  return {p.x - q.x, p.y - q.y, p.z - q.z};
+}
+template <class B>
+Vec3<B> cross(const Vec3<B>& p, const Vec3<B>& q) {
+  return {p.y * q.z - p.z * q.y, p.z * q.x - p.x * q.z, p.x * q.y - p.y * q.x};
+}
+template <class B>
+B dot(const Vec3<B>& p, const Vec3<B>& q) {
+  return p.x * q.x + p.y * q.y + p.z * q.z;
+}
+template <class B>
+B max_abs(const Vec3<B>& p) {
+  return xsimd::max(xsimd::max(xsimd::abs(p.x), xsimd::abs(p.y)), xsimd::abs(p.z));
+}
+
 template <class Arch>
 void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   using B = xsimd::batch<double, Arch>;
@@ -34,9 +57,7 @@ void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   const B eta_floor(1024 * std::numeric_limits<double>::denorm_min());
   const B low(0x1p-300), high(0x1p100);
   for (int i = 0; i < b.size; i += W) {
-    struct V {
-      B x, y, z;
-    };
+    using V = Vec3<B>;
     Mask finite(true);
     const auto point = [&](int p) {
       const V v{B::load_unaligned(&b.x[3 * p][i]), B::load_unaligned(&b.x[3 * p + 1][i]),
@@ -47,14 +68,6 @@ void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
     };
     const V x0[4] = {point(0), point(1), point(2), point(3)};
     const V x1[4] = {point(4), point(5), point(6), point(7)};
-    const auto sub = [](const V& p, const V& q) { return V{p.x - q.x, p.y - q.y, p.z - q.z}; };
-    const auto cross = [](const V& p, const V& q) {
-      return V{p.y * q.z - p.z * q.y, p.z * q.x - p.x * q.z, p.x * q.y - p.y * q.x};
-    };
-    const auto dot = [](const V& p, const V& q) { return p.x * q.x + p.y * q.y + p.z * q.z; };
-    const auto max_abs = [](const V& p) {
-      return xsimd::max(xsimd::max(xsimd::abs(p.x), xsimd::abs(p.y)), xsimd::abs(p.z));
-    };
     const V e1_0 = sub(x0[ib], x0[ia]), e2_0 = sub(x0[ic], x0[ia]);
     const V r0 = sub(x0[iq], x0[ia]);
     const V e1_1 = sub(x1[ib], x1[ia]), e2_1 = sub(x1[ic], x1[ia]);
@@ -93,9 +106,7 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   using Mask = xsimd::batch_bool<double, Arch>;
   constexpr int W = static_cast<int>(B::size);
   static_assert(NpBatch::kCapacity % W == 0);
-  struct V {
-    B x, y, z;
-  };
+  using V = Vec3<B>;
   struct I {  // certify.cpp's midpoint-radius interval
     B m, r;
   };
@@ -116,14 +127,6 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   const B sub_scale(128 * u);
   const B in_scale(2048 * u), in_floor(16384 * std::numeric_limits<double>::denorm_min());
   const B widen(1 + 1e-12);
-  const auto sub = [](const V& p, const V& q) { return V{p.x - q.x, p.y - q.y, p.z - q.z}; };
-  const auto cross = [](const V& p, const V& q) {
-    return V{p.y * q.z - p.z * q.y, p.z * q.x - p.x * q.z, p.x * q.y - p.y * q.x};
-  };
-  const auto dot = [](const V& p, const V& q) { return p.x * q.x + p.y * q.y + p.z * q.z; };
-  const auto max_abs = [](const V& p) {
-    return xsimd::max(xsimd::max(xsimd::abs(p.x), xsimd::abs(p.y)), xsimd::abs(p.z));
-  };
   const auto imul = [](const I& p, const I& q) {
     return I{p.m * q.m, xsimd::abs(p.m) * q.r + xsimd::abs(q.m) * p.r + p.r * q.r};
   };
@@ -135,25 +138,6 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   };
   const auto idot = [&](const IV& p, const IV& q) {
     return iadd(iadd(imul(p.x, q.x), imul(p.y, q.y)), imul(p.z, q.z));
-  };
-  // One sign over the range (cubic.hpp one_sign).
-  const auto one_sign = [](const B(&c)[4], const B& e) {
-    return ((c[0] > e) && (c[1] > e) && (c[2] > e) && (c[3] > e)) ||
-           ((c[0] < -e) && (c[1] < -e) && (c[2] < -e) && (c[3] < -e));
-  };
-  // cubic.hpp halve.
-  const auto halve = [&](const B(&c)[4], B(&l)[4], B(&r)[4]) {
-    const B b01 = (c[0] + c[1]) * half, b12 = (c[1] + c[2]) * half, b23 = (c[2] + c[3]) * half;
-    const B b012 = (b01 + b12) * half, b123 = (b12 + b23) * half;
-    const B mid = (b012 + b123) * half;
-    l[0] = c[0];
-    l[1] = b01;
-    l[2] = b012;
-    l[3] = mid;
-    r[0] = mid;
-    r[1] = b123;
-    r[2] = b23;
-    r[3] = c[3];
   };
   // The kept queries only, W at a time (a partial group repeats its last query).
   int kept[NpBatch::kCapacity];
