@@ -40,18 +40,42 @@ B max_abs(const Vec3<B>& p) {
   return xsimd::max(xsimd::max(xsimd::abs(p.x), xsimd::abs(p.y)), xsimd::abs(p.z));
 }
 
-template <class Arch>
-void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
-  using B = xsimd::batch<double, Arch>;
-  using Mask = xsimd::batch_bool<double, Arch>;
-  constexpr int W = static_cast<int>(B::size);
-  static_assert(NpBatch::kCapacity % W == 0);
+// cubic.cpp cubic_of, lane by lane: the coplanarity cubic's Bernstein coefficients k and the
+// largest coordinate a of the edge vectors it is built from (np_culls' error bound grows as a^3).
+template <class B>
+struct LaneCubic {
+  B k[4];
+  B a;
+};
+template <class B>
+LaneCubic<B> coplanarity_cubic(Kind kind, const Vec3<B> (&x0)[4], const Vec3<B> (&x1)[4]) {
   // Point indices of a, b, c, q (as in cubic_of).
   const int ia = kind == Kind::VertexFace ? 1 : 0;
   const int ib = kind == Kind::VertexFace ? 2 : 1;
   const int ic = kind == Kind::VertexFace ? 3 : 2;
   const int iq = kind == Kind::VertexFace ? 0 : 3;
   const B third(3.0);
+  const Vec3<B> e1_0 = sub(x0[ib], x0[ia]), e2_0 = sub(x0[ic], x0[ia]);
+  const Vec3<B> r0 = sub(x0[iq], x0[ia]);
+  const Vec3<B> e1_1 = sub(x1[ib], x1[ia]), e2_1 = sub(x1[ic], x1[ia]);
+  const Vec3<B> r1 = sub(x1[iq], x1[ia]);
+  const Vec3<B> n0 = cross(e1_0, e2_0), n1 = cross(e1_1, e2_1);
+  const Vec3<B> c01 = cross(e1_0, e2_1), c10 = cross(e1_1, e2_0);
+  const Vec3<B> nx2 = {c01.x + c10.x, c01.y + c10.y, c01.z + c10.z};
+  // The maximum is exact whatever the order (finite lanes; the others are undecided).
+  return {{dot(n0, r0), (dot(nx2, r0) + dot(n0, r1)) / third, (dot(nx2, r1) + dot(n1, r0)) / third,
+           dot(n1, r1)},
+          xsimd::max(xsimd::max(xsimd::max(max_abs(e1_0), max_abs(e2_0)),
+                                xsimd::max(max_abs(r0), max_abs(e1_1))),
+                     xsimd::max(max_abs(e2_1), max_abs(r1)))};
+}
+
+template <class Arch>
+void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
+  using B = xsimd::batch<double, Arch>;
+  using Mask = xsimd::batch_bool<double, Arch>;
+  constexpr int W = static_cast<int>(B::size);
+  static_assert(NpBatch::kCapacity % W == 0);
   const B big(DBL_MAX);
   const B eta_scale(256 * (DBL_EPSILON / 2));
   const B eta_floor(1024 * std::numeric_limits<double>::denorm_min());
@@ -68,25 +92,11 @@ void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
     };
     const V x0[4] = {point(0), point(1), point(2), point(3)};
     const V x1[4] = {point(4), point(5), point(6), point(7)};
-    const V e1_0 = sub(x0[ib], x0[ia]), e2_0 = sub(x0[ic], x0[ia]);
-    const V r0 = sub(x0[iq], x0[ia]);
-    const V e1_1 = sub(x1[ib], x1[ia]), e2_1 = sub(x1[ic], x1[ia]);
-    const V r1 = sub(x1[iq], x1[ia]);
-    const V n0 = cross(e1_0, e2_0), n1 = cross(e1_1, e2_1);
-    const V c01 = cross(e1_0, e2_1), c10 = cross(e1_1, e2_0);
-    const V nx2 = {c01.x + c10.x, c01.y + c10.y, c01.z + c10.z};
-    const B k0 = dot(n0, r0);
-    const B k1 = (dot(nx2, r0) + dot(n0, r1)) / third;
-    const B k2 = (dot(nx2, r1) + dot(n1, r0)) / third;
-    const B k3 = dot(n1, r1);
-    // The maximum is exact whatever the order (finite lanes; the others are undecided).
-    const B a = xsimd::max(xsimd::max(xsimd::max(max_abs(e1_0), max_abs(e2_0)),
-                                      xsimd::max(max_abs(r0), max_abs(e1_1))),
-                           xsimd::max(max_abs(e2_1), max_abs(r1)));
+    const LaneCubic<B> cubic = coplanarity_cubic(kind, x0, x1);
+    const B a = cubic.a;
     const B e = eta_scale * (a * a * a) + eta_floor;
     const Mask decided = finite && (a >= low) && (a <= high);
-    const Mask culled = ((k0 > e) && (k1 > e) && (k2 > e) && (k3 > e)) ||
-                        ((k0 < -e) && (k1 < -e) && (k2 < -e) && (k3 < -e));
+    const Mask culled = one_sign(cubic.k, e);
     bool d[W], c[W];
     decided.store_unaligned(d);
     culled.store_unaligned(c);
@@ -113,16 +123,12 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   struct IV {
     I x, y, z;
   };
-  const int ia = kind == Kind::VertexFace ? 1 : 0;
-  const int ib = kind == Kind::VertexFace ? 2 : 1;
-  const int ic = kind == Kind::VertexFace ? 3 : 2;
-  const int iq = kind == Kind::VertexFace ? 0 : 3;
   // inside_data's difference vectors (point index pairs).
   static constexpr int kVf[5][2] = {{2, 1}, {3, 1}, {0, 1}, {3, 2}, {0, 2}};
   static constexpr int kEe[5][2] = {{1, 0}, {3, 2}, {2, 0}, {1, 2}, {0, 3}};
   const auto& idx = kind == Kind::VertexFace ? kVf : kEe;
   constexpr double u = DBL_EPSILON / 2;
-  const B third(3.0), half(0.5);
+  const B half(0.5);
   const B eta_scale(256 * u), eta_floor(1024 * std::numeric_limits<double>::denorm_min());
   const B sub_scale(128 * u);
   const B in_scale(2048 * u), in_floor(16384 * std::numeric_limits<double>::denorm_min());
@@ -172,18 +178,9 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
                 B::load_aligned(col[3 * p + 14]) * scale};
     }
     // coplanarity_cubic (cubic.cpp cubic_of) and np_culls.
-    const V e1_0 = sub(x0[ib], x0[ia]), e2_0 = sub(x0[ic], x0[ia]);
-    const V r0 = sub(x0[iq], x0[ia]);
-    const V e1_1 = sub(x1[ib], x1[ia]), e2_1 = sub(x1[ic], x1[ia]);
-    const V r1 = sub(x1[iq], x1[ia]);
-    const V n0 = cross(e1_0, e2_0), n1 = cross(e1_1, e2_1);
-    const V c01 = cross(e1_0, e2_1), c10 = cross(e1_1, e2_0);
-    const V nx2 = {c01.x + c10.x, c01.y + c10.y, c01.z + c10.z};
-    const B k[4] = {dot(n0, r0), (dot(nx2, r0) + dot(n0, r1)) / third,
-                    (dot(nx2, r1) + dot(n1, r0)) / third, dot(n1, r1)};
-    const B a = xsimd::max(xsimd::max(xsimd::max(max_abs(e1_0), max_abs(e2_0)),
-                                      xsimd::max(max_abs(r0), max_abs(e1_1))),
-                           xsimd::max(max_abs(e2_1), max_abs(r1)));
+    const LaneCubic<B> cubic = coplanarity_cubic(kind, x0, x1);
+    const B(&k)[4] = cubic.k;
+    const B a = cubic.a;
     const B eta = eta_scale * (a * a * a) + eta_floor;
     const Mask np_culled = one_sign(k, eta);
     // fast_path_solve: subdivision_error, then the ranges down to the quarters of the step

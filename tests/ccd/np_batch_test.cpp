@@ -123,6 +123,11 @@ VertexFaceQuery vf_query(const Points& p) {
 EdgeEdgeQuery ee_query(const Points& p) {
   return {p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]};
 }
+// The GMP oracle's verdict on query p of this kind.
+bool exact_contact(Kind kind, const Points& p) {
+  return kind == Kind::VertexFace ? test::exact_vertex_face_contact(vf_query(p))
+                                  : test::exact_edge_edge_contact(ee_query(p));
+}
 
 TEST(NpBatch, MatchesTheScalarFilterOnRandomQueries) {
   int culled = 0, kept = 0, undecided = 0;
@@ -159,10 +164,7 @@ TEST(NpBatch, CullsNoQueryInContact) {
       for (std::size_t i = 0; i < qs.size(); ++i) {
         if (v[i] != NpVerdict::Culled) continue;
         ++culled;
-        const bool contact = kind == Kind::VertexFace
-                                 ? test::exact_vertex_face_contact(vf_query(qs[i]))
-                                 : test::exact_edge_edge_contact(ee_query(qs[i]));
-        EXPECT_FALSE(contact) << "seed " << seed << " query " << i;
+        EXPECT_FALSE(exact_contact(kind, qs[i])) << "seed " << seed << " query " << i;
       }
     }
   }
@@ -235,10 +237,7 @@ TEST(FastPathMisses, MissNoQueryInContact) {
       for (std::size_t i = 0; i < qs.size(); ++i) {
         if (!m[i]) continue;
         ++missed;
-        const bool contact = kind == Kind::VertexFace
-                                 ? test::exact_vertex_face_contact(vf_query(qs[i]))
-                                 : test::exact_edge_edge_contact(ee_query(qs[i]));
-        EXPECT_FALSE(contact) << "seed " << seed << " query " << i;
+        EXPECT_FALSE(exact_contact(kind, qs[i])) << "seed " << seed << " query " << i;
       }
     }
   }
