@@ -7,8 +7,11 @@ writes a markdown table of medians: refit, traversal, narrow phase, detection (t
 process wall time, and the detection's nanoseconds per triangle pair and per feature test.
 
 Usage: scripts/detect_speed.py [--ref BIN] [--bin BIN] [--reps N] [--threads 1,2] [--out FILE]
+                               [--frames OUT/frames]
   defaults: --bin build/release/apps/clothcd, no reference (current binary only), 5 reps,
   threads 1,2, output docs/results/detect_speed.md. Data: $CLOTHCD_DATA or ../shared/data.
+  --frames: the frames folder of a `scripts/results.sh OUT` run; adds simulated garment frame
+  pairs (dress-rumba and multilayer-rumba, frames 60 -> 61, sewn at 1e-3, patch build).
 """
 
 import argparse
@@ -29,13 +32,17 @@ def data_dir():
     return Path(os.environ.get("CLOTHCD_DATA", ROOT.parent / "shared" / "data")).resolve()
 
 
-def cases(data):
+# Simulated garment steps: (scene, first frame). Frame 60 is mid-sequence, the body in motion.
+SIMULATED = [("dress-rumba", 60), ("multilayer-rumba", 60)]
+
+
+def cases(data, frames=None):
     ball = data / "cloth-ball" / "frames"
     garments = data / "garments"
     # The garments' drape shapes (the body's vertices dropped), moved by a smooth 1 cm
     # perturbation: a garment-sized step without a simulation run first.
     garment = ["--perturb", "0.01", "--sew", "1e-3", "--bvh", "patch", "--garment-vertices"]
-    return [
+    out = [
         ("cloth_ball 92 -> 93",
          ["--t0", str(ball / "cloth_ball92.ply"), "--t1", str(ball / "cloth_ball93.ply")]),
         ("dress drape + 1 cm",
@@ -43,6 +50,14 @@ def cases(data):
         ("multilayer drape + 1 cm",
          ["--t0", str(garments / "multilayer" / "drape.obj"), *garment, "30464"]),
     ]
+    for scene, k in SIMULATED if frames else []:
+        f0, f1 = (Path(frames) / scene / f"frame_{i:04d}.obj" for i in (k, k + 1))
+        if not (f0.is_file() and f1.is_file()):
+            sys.exit(f"detect_speed.py: --frames {frames}: {f0} or {f1} is missing "
+                     "(expected the frames folder of a scripts/results.sh run)")
+        out.append((f"{scene} {k} -> {k + 1}",
+                    ["--t0", str(f0), "--t1", str(f1), "--sew", "1e-3", "--bvh", "patch"]))
+    return out
 
 
 def run(binary, args, threads, json_path):
@@ -65,14 +80,15 @@ def row(name, threads, label, runs):
     refit = statistics.median(s["time_refit"] for s in st)
     trav = statistics.median(s["time_traverse"] for s in st)
     narrow = statistics.median(s["time_narrow"] for s in st)
-    det = statistics.median(s["time_refit"] + s["time_traverse"] + s["time_narrow"] for s in st)
+    dets = [s["time_refit"] + s["time_traverse"] + s["time_narrow"] for s in st]
+    det = statistics.median(dets)
     wall = statistics.median(r[0] for r in runs)
     s = st[0]
     pairs = s["triangle_pairs"]
     tests = s["vf_tests"] + s["ee_tests"]
     return {
         "case": name, "threads": threads, "binary": label, "refit": refit, "traverse": trav,
-        "narrow": narrow, "detect": det, "wall": wall, "pairs": pairs, "tests": tests,
+        "narrow": narrow, "detect": det, "det_min": min(dets), "det_max": max(dets), "wall": wall, "pairs": pairs, "tests": tests,
         "ns_pair": 1e9 * det * threads / max(pairs, 1),
         "ns_test": 1e9 * det * threads / max(tests, 1),
         "collisions": s["vf_collisions"] + s["ee_collisions"],
@@ -86,12 +102,13 @@ def main():
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--threads", default="1,2")
     ap.add_argument("--out", default=str(ROOT / "docs" / "results" / "detect_speed.md"))
+    ap.add_argument("--frames", help="frames folder of a scripts/results.sh run (OUT/frames)")
     a = ap.parse_args()
     bins = [("current", a.bin)] + ([("reference", a.ref)] if a.ref else [])
     rows = []
     load_before = os.getloadavg()[0]
     with tempfile.TemporaryDirectory() as tmp:
-        for name, args in cases(data_dir()):
+        for name, args in cases(data_dir(), a.frames):
             for threads in [int(t) for t in a.threads.split(",")]:
                 runs = {label: [] for label, _ in bins}
                 for rep in range(a.reps):
@@ -136,14 +153,15 @@ def main():
         + (" Every run of both binaries reported the same VF and EE collisions, times of impact "
            "included." if a.ref else ""),
         "",
-        "| case | threads | binary | refit | traversal | narrow | detection | wall | triangle "
-        "pairs | feature tests | ns / pair | ns / test | collisions |",
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| case | threads | binary | refit | traversal | narrow | detection | detection min-max "
+        "| wall | triangle pairs | feature tests | ns / pair | ns / test | collisions |",
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         out.append(
             f"| {r['case']} | {r['threads']} | {r['binary']} | {r['refit']:.3f} | "
-            f"{r['traverse']:.3f} | {r['narrow']:.3f} | {r['detect']:.3f} | {r['wall']:.3f} | "
+            f"{r['traverse']:.3f} | {r['narrow']:.3f} | {r['detect']:.3f} | "
+            f"{r['det_min']:.3f}-{r['det_max']:.3f} | {r['wall']:.3f} | "
             f"{r['pairs']:,} | {r['tests']:,} | {r['ns_pair']:.0f} | {r['ns_test']:.0f} | "
             f"{r['collisions']:,} |")
     if a.ref:
