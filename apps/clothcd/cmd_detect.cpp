@@ -69,6 +69,64 @@ nlohmann::json stats_json(const DetectStats& s) {
           {"time_narrow", s.time_narrow}};
 }
 
+// A time of impact as JSON: the shortest text that reads back to the same double, always with a
+// fraction or exponent so that readers see a float (as nlohmann::json writes 0.0 and 1.0).
+void append_toi(fmt::memory_buffer& b, double t) {
+  const auto start = b.size();
+  fmt::format_to(std::back_inserter(b), "{}", t);
+  const std::string_view text(b.data() + start, b.size() - start);
+  if (text.find_first_of(".e") == std::string_view::npos)
+    fmt::format_to(std::back_inserter(b), ".0");
+}
+
+// The collisions and statistics of a step as JSON (keys in the order nlohmann::json sorts them),
+// one collision per line. Written directly: a document of 100 K collisions built as
+// nlohmann::json objects took longer than the detection's narrow phase.
+void write_result_json(std::ostream& out, const DetectResult& r, const nlohmann::json& stats,
+                       const std::vector<int>& original) {
+  fmt::memory_buffer b;
+  auto vf = [&](const char* key, const std::vector<VertexFaceCollision>& list, bool last) {
+    fmt::format_to(std::back_inserter(b), " \"{}\": [", key);
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const VertexFaceCollision& c = list[i];
+      fmt::format_to(
+          std::back_inserter(b), "{}\n  {{\"face\": [{}, {}, {}], \"toi\": ", i == 0 ? "" : ",",
+          original[c.face_vertices[0]], original[c.face_vertices[1]], original[c.face_vertices[2]]);
+      append_toi(b, c.toi);
+      fmt::format_to(std::back_inserter(b), ", \"vertex\": {}}}", original[c.vertex]);
+    }
+    fmt::format_to(std::back_inserter(b), "{}]{}\n", list.empty() ? "" : "\n ", last ? "" : ",");
+  };
+  auto ee = [&](const char* key, const std::vector<EdgeEdgeCollision>& list) {
+    fmt::format_to(std::back_inserter(b), " \"{}\": [", key);
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const EdgeEdgeCollision& c = list[i];
+      fmt::format_to(
+          std::back_inserter(b),
+          "{}\n  {{\"edge_a\": [{}, {}], \"edge_b\": [{}, {}], \"toi\": ", i == 0 ? "" : ",",
+          original[c.edge_a_vertices[0]], original[c.edge_a_vertices[1]],
+          original[c.edge_b_vertices[0]], original[c.edge_b_vertices[1]]);
+      append_toi(b, c.toi);
+      fmt::format_to(std::back_inserter(b), "}}");
+    }
+    fmt::format_to(std::back_inserter(b), "{}],\n", list.empty() ? "" : "\n ");
+  };
+  const research::Verification& ver = r.verification;
+  fmt::format_to(std::back_inserter(b), "{{\n");
+  ee("ee", r.ee);
+  if (ver.ran) {
+    ee("missed_ee", ver.missed_ee);
+    vf("missed_vf", ver.missed_vf, false);
+  }
+  std::string st = stats.dump(1);
+  for (std::size_t k = st.find('\n'); k != std::string::npos; k = st.find('\n', k + 2))
+    st.insert(k + 1, " ");
+  fmt::format_to(std::back_inserter(b), " \"stats\": {},\n", st);
+  vf("vf", r.vf, true);
+  fmt::format_to(std::back_inserter(b), "}}\n");
+  out.write(b.data(), static_cast<std::streamsize>(b.size()));
+}
+
 // The two frames of the step: --t1, or t0 plus a smooth perturbation; optionally cut to the
 // garment prefix of a drape.obj (its first N vertices and the faces that use only them).
 std::pair<TriangleMesh, TriangleMesh> load_frames(const Args& a) {
@@ -229,32 +287,8 @@ int run(const Args& a) {
         ver.missed_vf.size(), ver.missed_ee.size(), ver.unculled_triangle_pairs);
   }
   if (!a.json.empty()) {
-    auto vf_json = [&](const std::vector<VertexFaceCollision>& list) {
-      nlohmann::json out = nlohmann::json::array();
-      for (const auto& c : list) {
-        out.push_back({{"vertex", original[c.vertex]},
-                       {"face",
-                        {original[c.face_vertices[0]], original[c.face_vertices[1]],
-                         original[c.face_vertices[2]]}},
-                       {"toi", c.toi}});
-      }
-      return out;
-    };
-    auto ee_json = [&](const std::vector<EdgeEdgeCollision>& list) {
-      nlohmann::json out = nlohmann::json::array();
-      for (const auto& c : list) {
-        out.push_back({{"edge_a", {original[c.edge_a_vertices[0]], original[c.edge_a_vertices[1]]}},
-                       {"edge_b", {original[c.edge_b_vertices[0]], original[c.edge_b_vertices[1]]}},
-                       {"toi", c.toi}});
-      }
-      return out;
-    };
-    nlohmann::json j{{"vf", vf_json(r.vf)}, {"ee", ee_json(r.ee)}, {"stats", stats_json(s)}};
-    if (ver.ran) {
-      j["missed_vf"] = vf_json(ver.missed_vf);
-      j["missed_ee"] = ee_json(ver.missed_ee);
-    }
-    clothcd::app::write_json_atomically(a.json, j, 1);
+    clothcd::io_detail::write_atomically(
+        a.json, [&](std::ostream& out) { write_result_json(out, r, stats_json(s), original); });
   }
   return 0;
 }

@@ -12,8 +12,11 @@
 #include <vector>
 
 #include "cli_runner.hpp"
+#include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/mesh/triangle_mesh.hpp"
+#include "clothcd/research/options.hpp"
 
 namespace clothcd {
 namespace {
@@ -162,6 +165,50 @@ TEST(CliDeterminism, DetectSameForOneTwoAndFourThreads) {
   // The same collisions whatever the culling (the sound mode misses none).
   EXPECT_EQ(results[0]["vf"], results[1]["vf"]);
   EXPECT_EQ(results[0]["ee"], results[1]["ee"]);
+}
+
+TEST(CliDetect, JsonHoldsTheDetectorsCollisionsExactly) {
+  // The JSON is written directly (not through a JSON library): it must parse, and hold exactly
+  // the library's collisions, vertex ids and times of impact bit for bit, with --verify's lists.
+  CliScratch dir;
+  write_step(dir);
+  const auto r = dir.run("detect --t0 t0.obj --t1 t1.obj --culling cone --verify --json out.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(CliScratch::slurp(dir / "out.json"));
+  const TriangleMesh m0 = read_mesh(dir / "t0.obj"), m1 = read_mesh(dir / "t1.obj");
+  DetectOptions o;
+  o.research.unsound_culling = research::UnsoundCulling::Cone;
+  o.research.verify = true;
+  SelfDetector det(m0.faces, m0.num_vertices(), vertices_matrix(m0), o);
+  const DetectResult want = det.detect(vertices_matrix(m0), vertices_matrix(m1));
+  ASSERT_GT(want.vf.size() + want.ee.size(), 0u) << "no collisions to compare";
+  const auto vf_json = [](const std::vector<VertexFaceCollision>& list) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& c : list) {
+      out.push_back({{"vertex", c.vertex},
+                     {"face", {c.face_vertices[0], c.face_vertices[1], c.face_vertices[2]}},
+                     {"toi", c.toi}});
+    }
+    return out;
+  };
+  const auto ee_json = [](const std::vector<EdgeEdgeCollision>& list) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& c : list) {
+      out.push_back({{"edge_a", {c.edge_a_vertices[0], c.edge_a_vertices[1]}},
+                     {"edge_b", {c.edge_b_vertices[0], c.edge_b_vertices[1]}},
+                     {"toi", c.toi}});
+    }
+    return out;
+  };
+  EXPECT_EQ(j["vf"], vf_json(want.vf));
+  EXPECT_EQ(j["ee"], ee_json(want.ee));
+  EXPECT_EQ(j["missed_vf"], vf_json(want.verification.missed_vf));
+  EXPECT_EQ(j["missed_ee"], ee_json(want.verification.missed_ee));
+  for (const auto& c : j["ee"])
+    EXPECT_TRUE(c["toi"].is_number_float()) << c;
+  EXPECT_EQ(j["stats"]["triangle_pairs"].get<std::uint64_t>(), want.stats.triangle_pairs);
+  EXPECT_EQ(j["stats"]["ee_collisions"].get<std::uint64_t>(), want.ee.size());
+  EXPECT_EQ(j.size(), 5u) << "vf, ee, missed_vf, missed_ee, stats";
 }
 
 TEST(CliDetect, ThicknessReportsTrianglePairsCulledWhole) {
