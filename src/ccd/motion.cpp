@@ -11,6 +11,31 @@
 
 namespace clothcd::ccd_detail {
 
+namespace {
+
+// The scaled positions and their extents. Plain per-coordinate loops (the same products, minima
+// and maxima, in the same order, as vector expressions): this runs once for every query past the
+// NP filter.
+template <class Scale>
+void fill_scaled(Motion& out, const std::array<const Eigen::Vector3d*, 8>& points, Scale scale) {
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  double top[3] = {0, 0, 0};
+  for (int k = 0; k < 4; ++k) {
+    for (int a = 0; a < 3; ++a) {
+      const double p = scale((*points[k])[a]), q = scale((*points[k + 4])[a]);
+      out.x0[k][a] = p;
+      out.x1[k][a] = q;
+      lo[a] = std::min(std::min(lo[a], p), q);
+      hi[a] = std::max(std::max(hi[a], p), q);
+      top[a] = std::max(std::max(top[a], std::abs(p)), std::abs(q));
+    }
+  }
+  out.max_abs = Eigen::Vector3d(top[0], top[1], top[2]);
+  out.extent = std::max(std::max(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
+}
+
+}  // namespace
+
 Motion make_motion(const std::array<const Eigen::Vector3d*, 8>& points) {
   double m = 0;
   for (int i = 0; i < 8; ++i) {
@@ -23,35 +48,33 @@ Motion make_motion(const std::array<const Eigen::Vector3d*, 8>& points) {
     m = std::max(m, std::max(std::max(ax, ay), az));
   }
   Motion out;
-  out.scale = inverse_binade(m);
-  // Plain per-coordinate loops (the same products, minima and maxima, in the same order, as
-  // vector expressions): this runs once for every query past the NP filter.
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  double top[3] = {0, 0, 0};
-  for (int k = 0; k < 4; ++k) {
-    for (int a = 0; a < 3; ++a) {
-      const double p = (*points[k])[a] * out.scale, q = (*points[k + 4])[a] * out.scale;
-      out.x0[k][a] = p;
-      out.x1[k][a] = q;
-      lo[a] = std::min(std::min(lo[a], p), q);
-      hi[a] = std::max(std::max(hi[a], p), q);
-      top[a] = std::max(std::max(top[a], std::abs(p)), std::abs(q));
-    }
+  out.largest = m;
+  out.scale_exponent = -binade_exponent(m);
+  if (out.scale_exponent <= DBL_MAX_EXP - 1) {
+    const double scale = out.scale = inverse_binade(m);
+    fill_scaled(out, points, [scale](double x) { return x * scale; });
+  } else {
+    // Every coordinate is below 2^-1023, and 2^scale_exponent is no double: std::ldexp scales
+    // them, exactly (the results are normal).
+    out.scale = 0;
+    const int k = out.scale_exponent;
+    fill_scaled(out, points, [k](double x) { return std::ldexp(x, k); });
   }
-  out.max_abs = Eigen::Vector3d(top[0], top[1], top[2]);
-  out.extent = std::max(std::max(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
   return out;
 }
 
-double inverse_binade(double m) {
-  // frexp's exponent e (m = f 2^e, f in [0.5, 1)) read off the bits of a normal m, and 2^-e
-  // built from bits where it is normal; ldexp and frexp elsewhere.
+int binade_exponent(double m) {
+  // Read off the bits of a normal m; std::frexp elsewhere.
+  if (m >= DBL_MIN && m <= DBL_MAX)
+    return static_cast<int>(std::bit_cast<std::uint64_t>(m) >> 52) - 1022;
   int e = 0;
-  if (m >= DBL_MIN && m <= DBL_MAX) {
-    e = static_cast<int>(std::bit_cast<std::uint64_t>(m) >> 52) - 1022;
-  } else if (m > 0) {
-    std::frexp(m, &e);
-  }
+  if (m > 0) std::frexp(m, &e);
+  return e;
+}
+
+double inverse_binade(double m) {
+  // 2^-e built from bits where it is normal; ldexp elsewhere.
+  const int e = binade_exponent(m);
   if (-e >= DBL_MIN_EXP - 1 && -e <= DBL_MAX_EXP - 1) {
     return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - e) << 52);
   }

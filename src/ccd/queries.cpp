@@ -63,7 +63,7 @@ CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points, co
     return r;
   }
   const Motion m = ccd_detail::make_motion(points);
-  const double max_coord = m.max_abs.maxCoeff() / m.scale;
+  const double max_coord = m.largest;
   // Any two of the points are within 2 sqrt(3) max|x| < 4 max|x|: contact from the start. This
   // also keeps the scaled thickness finite.
   if (opt.thickness >= 4 * max_coord) {
@@ -73,7 +73,7 @@ CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points, co
     return r;
   }
   ccd_detail::InclusionParams p;
-  p.thickness = opt.thickness * m.scale;
+  p.thickness = m.scale > 0 ? opt.thickness * m.scale : std::ldexp(opt.thickness, m.scale_exponent);
   p.tolerance = opt.tolerance * m.extent;
   p.toi_tolerance = opt.toi_tolerance;
   p.max_boxes = opt.max_boxes;

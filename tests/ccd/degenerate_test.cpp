@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,13 @@ VertexFaceQuery transform(VertexFaceQuery q, double s, const V& shift) {
   }
   return q;
 }
+std::vector<V> points_of(const VertexFaceQuery& q) {
+  return {q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0, q.v_t1, q.f0_t1, q.f1_t1, q.f2_t1};
+}
+std::vector<V> points_of(const EdgeEdgeQuery& q) {
+  return {q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0, q.ea0_t1, q.ea1_t1, q.eb0_t1, q.eb1_t1};
+}
+
 EdgeEdgeQuery transform(EdgeEdgeQuery q, double s, const V& shift) {
   for (V* p :
        {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0, &q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1}) {
@@ -244,6 +252,53 @@ TEST(CcdDegenerate, VertexFaceTable) {
 TEST(CcdDegenerate, EdgeEdgeTable) {
   for (const auto& c : ee_cases())
     check(c);
+}
+
+// Scaling a query by a power of two changes nothing, also where every coordinate ends up below
+// 2^-1023 (subnormal or nearly): the kernel must give the unit-scale query's answer and time of
+// impact, in both modes. Coordinates on a grid of 1/16 up to 64 scale exactly to 2^-1050.
+TEST(CcdDegenerate, AllSubnormalQueriesAnswerAsAtUnitScale) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> grid(-1024, 1024);
+  auto point = [&] {
+    V p;
+    for (int a = 0; a < 3; ++a)
+      p[a] = grid(rng) / 16.0;
+    return p;
+  };
+  int hits = 0, misses = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const V d = point() / 8;  // short motions: a mix of contacts and misses
+    const VertexFaceQuery vf{point(),     point(),     point(),     point(),
+                             point() + d, point() + d, point() + d, point() + d};
+    const EdgeEdgeQuery ee{point(), point(), point(), point(), point(), point(), point(), point()};
+    for (int k : {-1040, -1050}) {
+      const auto svf = transform(vf, std::ldexp(1.0, k), V::Zero());
+      const auto see = transform(ee, std::ldexp(1.0, k), V::Zero());
+      // Back in two exact steps (2^-k itself is no double).
+      const double half = std::ldexp(1.0, -k / 2), rest = std::ldexp(1.0, -k - (-k / 2));
+      ASSERT_EQ(points_of(transform(transform(svf, half, V::Zero()), rest, V::Zero())),
+                points_of(vf));
+      ASSERT_EQ(points_of(transform(transform(see, half, V::Zero()), rest, V::Zero())),
+                points_of(ee));
+      for (bool fast : {true, false}) {
+        CcdOptions opt;
+        opt.fast_path = fast;
+        const std::string where =
+            std::to_string(i) + " at 2^" + std::to_string(k) + (fast ? " (fast)" : " (incl)");
+        const CcdResult want_vf = vertex_face_ccd(vf, opt), got_vf = vertex_face_ccd(svf, opt);
+        EXPECT_EQ(got_vf.hit, want_vf.hit) << "VF " << where;
+        EXPECT_EQ(got_vf.toi, want_vf.toi) << "VF " << where;
+        const CcdResult want_ee = edge_edge_ccd(ee, opt), got_ee = edge_edge_ccd(see, opt);
+        EXPECT_EQ(got_ee.hit, want_ee.hit) << "EE " << where;
+        EXPECT_EQ(got_ee.toi, want_ee.toi) << "EE " << where;
+        (want_vf.hit ? hits : misses) += 1;
+        (want_ee.hit ? hits : misses) += 1;
+      }
+    }
+  }
+  EXPECT_GT(hits, 100);
+  EXPECT_GT(misses, 100);
 }
 
 TEST(CcdDegenerate, ThicknessContactsBeforeTouching) {

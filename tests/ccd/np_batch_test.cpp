@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -284,12 +285,17 @@ TEST(FastPathMisses, MakeMotionMatchesItsVectorForm) {
         m = std::max(m, x.cwiseAbs().maxCoeff());
       int e = 0;
       if (m > 0) std::frexp(m, &e);
-      const double scale = std::ldexp(1.0, -e);
       V lo = V::Constant(INFINITY), hi = -lo, top = V::Zero();
       const ccd_detail::Motion got = ccd_detail::make_motion(pts);
-      ASSERT_EQ(got.scale, scale);
+      ASSERT_EQ(got.scale_exponent, -e);
+      // 2^-e, or 0 where it is no double (every coordinate below 2^-1023).
+      ASSERT_EQ(got.scale, -e <= DBL_MAX_EXP - 1 ? std::ldexp(1.0, -e) : 0.0);
+      ASSERT_EQ(got.largest, m);
+      const auto scaled = [e](const V& x) {
+        return V(std::ldexp(x[0], -e), std::ldexp(x[1], -e), std::ldexp(x[2], -e));
+      };
       for (int k = 0; k < 4; ++k) {
-        const V a = p[k] * scale, b = p[k + 4] * scale;
+        const V a = scaled(p[k]), b = scaled(p[k + 4]);
         for (const V* x : {&a, &b}) {
           lo = lo.cwiseMin(*x);
           hi = hi.cwiseMax(*x);
@@ -300,13 +306,9 @@ TEST(FastPathMisses, MakeMotionMatchesItsVectorForm) {
           EXPECT_EQ(std::bit_cast<std::uint64_t>(got.x1[k][c]), std::bit_cast<std::uint64_t>(b[c]));
         }
       }
-      // Equal, or both NaN (queries of subnormal magnitude below 2^-1023 scale by infinity).
-      const auto same = [](double a, double b) {
-        return a == b || (std::isnan(a) && std::isnan(b));
-      };
       for (int c = 0; c < 3; ++c)
-        EXPECT_PRED2(same, got.max_abs[c], top[c]);
-      EXPECT_PRED2(same, got.extent, (hi - lo).maxCoeff());
+        EXPECT_EQ(got.max_abs[c], top[c]);
+      EXPECT_EQ(got.extent, (hi - lo).maxCoeff());
     }
   }
 }
