@@ -6,11 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <random>
 #include <set>
 #include <utility>
 #include <vector>
 
 #include "clothcd/detect/procedural.hpp"
+#include "detect/traversal.hpp"
 
 // Helpers in a namespace of their own: the tests of a folder may share one translation unit.
 namespace clothcd::traverse_test {
@@ -100,6 +102,97 @@ TEST(Traverse, PairPairsAreTheOverlappingLeafBoxesOfTwoMeshes) {
     const auto parallel = overlapping_leaf_pairs(x, y);
     EXPECT_EQ(PairSet(parallel.begin(), parallel.end()), expected);
     EXPECT_EQ(parallel.size(), expected.size());
+  }
+}
+
+// What the traversal runs, leaf pairs (node ids, in order) and counters, against the plain loop
+// of its single steps that run() streamlines.
+struct Trace {
+  std::vector<std::pair<int, int>> leaves;
+  detail::TraversalCounters c;
+};
+
+template <class Tr>
+Trace by_steps(const Tr& tr, const detail::Task& root) {
+  Trace t;
+  std::vector<detail::Task> stack{root};
+  while (!stack.empty()) {
+    const detail::Task task = stack.back();
+    stack.pop_back();
+    tr.step(task, t.c, t.leaves, [&](const detail::Task& s) { stack.push_back(s); });
+  }
+  return t;
+}
+
+template <class Tr>
+Trace by_run(const Tr& tr, const detail::Task& root) {
+  Trace t;
+  tr.run(root, t.c, t.leaves);
+  return t;
+}
+
+void expect_same(const Trace& a, const Trace& b) {
+  EXPECT_EQ(a.leaves, b.leaves);
+  EXPECT_EQ(a.c.box_tests, b.c.box_tests);
+  EXPECT_EQ(a.c.culled, b.c.culled);
+  EXPECT_EQ(a.c.cone_tests, b.c.cone_tests);
+}
+
+TEST(Traverse, RunMakesTheSameTestsAndPairsAsItsSteps) {
+  const ProceduralScene a = crumpled_sheet(12, 4), b = twisted_strip(40, 3);
+  const Topology ta(a.faces, a.num_vertices), tb(b.faces, b.num_vertices);
+  const auto a0 = points(a.v_t0), a1 = points(a.v_t1);
+  const auto b0 = points(b.v_t0, {0.2, 0.1, 0.0}), b1 = points(b.v_t1, {0.2, 0.1, 0.0});
+  std::mt19937_64 rng(11);
+  for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+    Bvh x(ta, a0, build), y(tb, b0, build);
+    RefitOptions ro;
+    ro.thickness = 0.01;
+    x.refit(a0, a1, ro);
+    y.refit(b0, b1, ro);
+    // Culls a fixed third of the internal nodes, counting every question as a cone test.
+    auto cull = [](int i, detail::TraversalCounters& c) {
+      ++c.cone_tests;
+      return i % 3 == 1;
+    };
+    auto no_cull = [](int, detail::TraversalCounters&) { return false; };
+    auto leaf = [](int i, int j, std::vector<std::pair<int, int>>& out) { out.emplace_back(i, j); };
+    // The nodes above a random eighth of the faces, as the detectors' active restriction.
+    auto random_flags = [&](const Bvh& t) {
+      std::vector<std::uint8_t> f(t.faces().size());
+      for (auto& v : f)
+        v = rng() % 8 == 0 ? 1 : 0;
+      return t.nodes_holding(f);
+    };
+    const std::vector<std::uint8_t> fx = random_flags(x), fy = random_flags(y);
+    const std::span<const BvhNode> nx = x.nodes(), ny = y.nodes();
+    for (bool active : {false, true}) {
+      SCOPED_TRACE(::testing::Message() << "build " << int(build) << " active " << active);
+      std::span<const std::uint8_t> ax, ay;
+      if (active) {
+        ax = fx;
+        ay = fy;
+      }
+      const auto self = detail::make_traversal(nx, nx, ax, ax, cull, leaf);
+      const auto plain = detail::make_traversal(nx, nx, ax, ax, no_cull, leaf);
+      const auto two = detail::make_traversal(nx, ny, ax, ay, no_cull, leaf);
+      const auto swapped = detail::make_traversal(ny, nx, ay, ax, no_cull, leaf);
+      const Trace s = by_steps(self, {0, 0, true}), p = by_steps(plain, {0, 0, true});
+      const Trace t = by_steps(two, {0, 0, false}), w = by_steps(swapped, {0, 0, false});
+      ASSERT_GT(s.c.culled, 0u);
+      ASSERT_GT(p.leaves.size(), s.leaves.size());
+      ASSERT_FALSE(t.leaves.empty());
+      expect_same(by_run(self, {0, 0, true}), s);
+      expect_same(by_run(plain, {0, 0, true}), p);
+      expect_same(by_run(two, {0, 0, false}), t);
+      expect_same(by_run(swapped, {0, 0, false}), w);
+      // Roots below the top, as the parallel frontier hands them out.
+      for (int i : {1, 2, 5}) {
+        expect_same(by_run(self, {i, i, true}), by_steps(self, {i, i, true}));
+        expect_same(by_run(plain, {1, i, false}), by_steps(plain, {1, i, false}));
+        expect_same(by_run(two, {i, 2, false}), by_steps(two, {i, 2, false}));
+      }
+    }
   }
 }
 

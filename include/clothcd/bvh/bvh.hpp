@@ -14,6 +14,10 @@
 #include <span>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "clothcd/bvh/aabb.hpp"
 #include "clothcd/geometry/cone.hpp"
 #include "clothcd/mesh/topology.hpp"
@@ -51,9 +55,21 @@ struct BvhNode {
 };
 static_assert(sizeof(BvhNode) == 64, "BvhNode must stay one cache line");
 
-/// Box overlap of two nodes (closed boxes).
+/// Box overlap of two nodes (closed boxes): overlap(a.lo, a.hi, b.lo, b.hi), the traversals'
+/// most frequent test. On x86-64 its six comparisons as three SSE2 comparisons of two lanes (the
+/// same double comparisons, so the same answers, NaN included).
 [[nodiscard]] inline bool overlap(const BvhNode& a, const BvhNode& b) {
+#if defined(__SSE2__)
+  // Lanes (lo0, lo1) <= (hi0, hi1) both ways, then (a.lo2, b.lo2) <= (b.hi2, a.hi2).
+  const __m128d ab01 = _mm_cmple_pd(_mm_loadu_pd(a.lo.data()), _mm_loadu_pd(b.hi.data()));
+  const __m128d ba01 = _mm_cmple_pd(_mm_loadu_pd(b.lo.data()), _mm_loadu_pd(a.hi.data()));
+  const __m128d lo2 = _mm_loadh_pd(_mm_load_sd(&a.lo[2]), &b.lo[2]);
+  const __m128d hi2 = _mm_loadh_pd(_mm_load_sd(&b.hi[2]), &a.hi[2]);
+  const __m128d all = _mm_and_pd(_mm_and_pd(ab01, ba01), _mm_cmple_pd(lo2, hi2));
+  return _mm_movemask_pd(all) == 3;
+#else
   return overlap(a.lo, a.hi, b.lo, b.hi);
+#endif
 }
 
 /// Options of a refit.
