@@ -791,13 +791,92 @@ inline bool has_corner(const Face& t, int x) {
   return x == t[0] || x == t[1] || x == t[2];
 }
 
+/// Bit 3 i + j set for every i in `rows` and j in `cols` (3-bit masks).
+inline unsigned outer_bits(unsigned rows, unsigned cols) {
+  const unsigned spread_cols = cols * 0x49u;  // cols at bits 0, 3, 6
+  const unsigned spread_rows =
+      (rows & 1u) * 7u | ((rows >> 1) & 1u) * 0x38u | ((rows >> 2) & 1u) * 0x1c0u;
+  return spread_rows & spread_cols;
+}
+
+/// Where ownership of a triangle pair (f, g)'s feature pairs needs the ordered search, in
+/// FeatureOverlaps' bit layout, from the faces' records rf and rg (see owned_feature_pairs): VF
+/// bit k, when a corner of g (of f) is one of the two other corners of the first face of f's (g's)
+/// corner k; EE bit 3 i + j, when the apex wb of edge j of g is a corner of f, the apex wa of edge
+/// i of f a corner of g, or wa == wb. Lane by lane, the reference of search_masks.
+inline FeatureOverlaps search_masks_scalar(const Ownership::FaceRecord& rf,
+                                           const Ownership::FaceRecord& rg) {
+  FeatureOverlaps m;
+  for (int k = 0; k < 3; ++k) {
+    m.vf_f |= unsigned(has_corner(rg.v, rf.other[k][0]) || has_corner(rg.v, rf.other[k][1])) << k;
+    m.vf_g |= unsigned(has_corner(rf.v, rg.other[k][0]) || has_corner(rf.v, rg.other[k][1])) << k;
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const int wa = rf.apex[i], wb = rg.apex[j];
+      m.ee |= unsigned(has_corner(rf.v, wb) || has_corner(rg.v, wa) || wa == wb) << (3 * i + j);
+    }
+  }
+  return m;
+}
+
+/// search_masks_scalar with SSE2 integer compares: each corner of one face against the other
+/// face's first-face corners and apexes four at a time, the apexes against each other by rows.
+/// Equality of ints, so the same bits.
+inline FeatureOverlaps search_masks(const Ownership::FaceRecord& rf,
+                                    const Ownership::FaceRecord& rg) {
+#if defined(__SSE2__)
+  static_assert(offsetof(Ownership::FaceRecord, other) == 24 &&
+                offsetof(Ownership::FaceRecord, apex) == 48 && sizeof(Ownership::FaceRecord) == 64);
+  const auto load = [](const Ownership::FaceRecord& r, int word) {
+    return _mm_loadu_si128(
+        reinterpret_cast<const __m128i*>(reinterpret_cast<const int*>(&r) + word));
+  };
+  const auto mask = [](__m128i x) {
+    return static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(x)));
+  };
+  // Words 0..3: v[0..2], e[0]; 6..9: other[0], other[1]; 10..13: other[2], apex[0..1];
+  // 12..15: apex[0..2], first. Lanes past the fields are masked off below.
+  const __m128i vf = load(rf, 0), vg = load(rg, 0);
+  const __m128i of01 = load(rf, 6), of2 = load(rf, 10), af = load(rf, 12);
+  const __m128i og01 = load(rg, 6), og2 = load(rg, 10), ag = load(rg, 12);
+  __m128i tf01 = _mm_setzero_si128(), tf2 = tf01, taf = tf01;  // ... equals a corner of g
+  __m128i tg01 = tf01, tg2 = tf01, tag = tf01;                 // ... equals a corner of f
+  const auto corner = [&](__m128i cg, __m128i cf) {
+    tf01 = _mm_or_si128(tf01, _mm_cmpeq_epi32(of01, cg));
+    tf2 = _mm_or_si128(tf2, _mm_cmpeq_epi32(of2, cg));
+    taf = _mm_or_si128(taf, _mm_cmpeq_epi32(af, cg));
+    tg01 = _mm_or_si128(tg01, _mm_cmpeq_epi32(og01, cf));
+    tg2 = _mm_or_si128(tg2, _mm_cmpeq_epi32(og2, cf));
+    tag = _mm_or_si128(tag, _mm_cmpeq_epi32(ag, cf));
+  };
+  corner(_mm_shuffle_epi32(vg, 0x00), _mm_shuffle_epi32(vf, 0x00));
+  corner(_mm_shuffle_epi32(vg, 0x55), _mm_shuffle_epi32(vf, 0x55));
+  corner(_mm_shuffle_epi32(vg, 0xaa), _mm_shuffle_epi32(vf, 0xaa));
+  const auto pairs = [](unsigned m01, unsigned m2) {  // other[k][0] or other[k][1] matched
+    return unsigned((m01 & 3u) != 0) | unsigned((m01 & 12u) != 0) << 1 |
+           unsigned((m2 & 3u) != 0) << 2;
+  };
+  FeatureOverlaps m;
+  m.vf_f = pairs(mask(tf01), mask(tf2));
+  m.vf_g = pairs(mask(tg01), mask(tg2));
+  const unsigned same = (mask(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0x00))) & 7u) |
+                        (mask(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0x55))) & 7u) << 3 |
+                        (mask(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0xaa))) & 7u) << 6;
+  m.ee = outer_bits(mask(taf) & 7u, 7u) | outer_bits(7u, mask(tag) & 7u) | same;
+  return m;
+#else
+  return search_masks_scalar(rf, rg);
+#endif
+}
+
 /// The feature pairs of the triangle pair (f, g), sharing no vertex, whose R-triangle pair it is
 /// (docs/algorithms.md 6.3) and whose boxes overlap: vf(v, face, corners of face) for a vertex of
 /// one face against the other, ee(e1, e2, vertices of e1, vertices of e2) with e1 < e2 for an edge
 /// of each. Box tests first (cheap, they reject most: `boxes.overlaps`, see FeatureOverlaps),
 /// then ownership from the faces' records: a set bit of `first` settles it; otherwise the first
 /// candidate of the ordered search owns the pair, and it is not (f, g), unless that candidate
-/// touches the other face, and the records tell when it can:
+/// touches the other face, and the records tell when it can (search_masks):
 ///  - VF (v of f, against g): the search starts at v's first face h, which is not f. h holds v,
 ///    which g lacks, so h touches g exactly when one of h's other two corners is in g.
 ///  - EE (edge a of f, edge b of g): the search starts at the edges' first faces ha = a + wa and
@@ -811,40 +890,33 @@ void owned_feature_pairs(const Ownership& owner, const Boxes& boxes, int f, int 
   const Ownership::FaceRecord& rf = owner.record(f);
   const Ownership::FaceRecord& rg = owner.record(g);
   const FeatureOverlaps o = boxes.overlaps(rf, rg, f, g);
+  if ((o.vf_f | o.vf_g | o.ee) == 0) return;
+  const FeatureOverlaps search = search_masks(rf, rg);
   const unsigned mf = rf.first, mg = rg.first;
-  for (unsigned bits = o.vf_f; bits != 0; bits &= bits - 1) {
+  // Owned outright: first faces of the vertex, of both edges.
+  const unsigned first_ee = outer_bits((mf >> 3) & 7u, (mg >> 3) & 7u);
+  for (unsigned bits = o.vf_f & ((mf & 7u) | search.vf_f); bits != 0; bits &= bits - 1) {
     const int k = std::countr_zero(bits);
     const int v = rf.v[k];
-    if (!((mf >> k) & 1u) &&
-        !((has_corner(rg.v, rf.other[k][0]) || has_corner(rg.v, rf.other[k][1])) &&
-          owner.owns_vf(v, g, f))) {
-      continue;
-    }
+    if (!((mf >> k) & 1u) && !owner.owns_vf(v, g, f)) continue;
     vf(v, g, rg.v);
   }
-  for (unsigned bits = o.vf_g; bits != 0; bits &= bits - 1) {
+  for (unsigned bits = o.vf_g & ((mg & 7u) | search.vf_g); bits != 0; bits &= bits - 1) {
     const int k = std::countr_zero(bits);
     const int v = rg.v[k];
-    if (!((mg >> k) & 1u) &&
-        !((has_corner(rf.v, rg.other[k][0]) || has_corner(rf.v, rg.other[k][1])) &&
-          owner.owns_vf(v, f, g))) {
-      continue;
-    }
+    if (!((mg >> k) & 1u) && !owner.owns_vf(v, f, g)) continue;
     vf(v, f, rf.v);
   }
-  for (unsigned bits = o.ee; bits != 0; bits &= bits - 1) {
+  for (unsigned bits = o.ee & (first_ee | search.ee); bits != 0; bits &= bits - 1) {
     const int n = std::countr_zero(bits);
     const int i = n / 3, j = n % 3;
     const int ea = rf.e[i], eb = rg.e[j];
     const bool a_first = ea < eb;
     const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;
-    bool mine = (mf >> (3 + i)) & (mg >> (3 + j)) & 1u;
-    if (!mine) {
-      const int wa = rf.apex[i], wb = rg.apex[j];
-      mine = (has_corner(rf.v, wb) || has_corner(rg.v, wa) || wa == wb) &&
-             (a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f));
+    if (!((first_ee >> n) & 1u) &&
+        !(a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f))) {
+      continue;
     }
-    if (!mine) continue;
     if (a_first) {
       ee(e1, e2, rf.edge(i), rg.edge(j));
     } else {

@@ -48,7 +48,8 @@ inline void expect_blocks(const detail::FeatureContext& ctx) {
 }
 
 /// For the pair (f, g), sharing no vertex: the same overlaps from the blocks (vector and lane by
-/// lane) as from the separate boxes, and the same feature pairs in the same order. Returns the
+/// lane) as from the separate boxes, the same search masks from both forms, and the same
+/// feature pairs in the same order. Returns the
 /// number of feature pairs.
 inline std::size_t check_pair(const detail::Ownership& owner, const detail::FeatureContext& ctx,
                               int f, int g) {
@@ -59,6 +60,8 @@ inline std::size_t check_pair(const detail::Ownership& owner, const detail::Feat
   const detail::FeatureOverlaps want = separate.overlaps(rf, rg, f, g);
   EXPECT_EQ(blocks.overlaps(rf, rg, f, g), want) << "faces " << f << ", " << g;
   EXPECT_EQ(detail::feature_overlaps_scalar(ctx.face_boxes[f], ctx.face_boxes[g]), want)
+      << "faces " << f << ", " << g;
+  EXPECT_EQ(detail::search_masks(rf, rg), detail::search_masks_scalar(rf, rg))
       << "faces " << f << ", " << g;
   const auto pairs = yielded(owner, separate, f, g);
   EXPECT_EQ(yielded(owner, blocks, f, g), pairs) << "faces " << f << ", " << g;

@@ -1,10 +1,12 @@
 // The pair loop's box blocks (detail::FaceBoxes, feature_overlaps, StepFaceBoxes) against the
 // separate boxes and the scalar box test: the same overlap bits on random blocks (ties and NaN
 // included), and on procedural meshes and random triangles the same blocks as the boxes they
-// gather, after full and partial updates, and the same feature pairs from owned_feature_pairs.
+// gather, after full and partial updates, and the same feature pairs from owned_feature_pairs;
+// the ownership search masks (search_masks) against their scalar form.
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -122,6 +124,41 @@ TEST(FaceBoxes, SameFeaturePairsAsTheSeparateBoxesOnRandomTriangles) {
     n += check_mesh(faces, v0, v1, gen);
   }
   EXPECT_GT(n, 1000u);
+}
+
+TEST(FaceBoxes, SearchMasksEqualTheScalarFormOnRandomMeshes) {
+  // Few vertices and many faces (boundaries, non-manifold edges, duplicates): first faces and
+  // apexes that often touch the other face.
+  std::size_t touching = 0;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    test::Gen gen(seed);
+    const int nv = gen.integer(8, 24);
+    std::vector<Face> faces;
+    for (int i = gen.integer(4, 40); i > 0; --i) {
+      Face t{};
+      t[0] = gen.integer(0, nv - 1);
+      do {
+        t[1] = gen.integer(0, nv - 1);
+      } while (t[1] == t[0]);
+      do {
+        t[2] = gen.integer(0, nv - 1);
+      } while (t[2] == t[0] || t[2] == t[1]);
+      faces.push_back(t);
+    }
+    const Topology topo(faces, nv);
+    const detail::Ownership owner(topo);
+    for (int f = 0; f < topo.num_faces(); ++f) {
+      for (int g = 0; g < topo.num_faces(); ++g) {
+        if (f == g || detail::share_vertex(faces[f], faces[g])) continue;
+        const detail::FeatureOverlaps want =
+            detail::search_masks_scalar(owner.record(f), owner.record(g));
+        ASSERT_EQ(detail::search_masks(owner.record(f), owner.record(g)), want)
+            << "seed " << seed << " faces " << f << ", " << g;
+        touching += static_cast<std::size_t>(std::popcount(want.vf_f) + std::popcount(want.ee));
+      }
+    }
+  }
+  EXPECT_GT(touching, 1000u);
 }
 
 }  // namespace
