@@ -726,7 +726,8 @@ inline FeatureOverlaps feature_overlaps_scalar(const FaceBoxes& a, const FaceBox
 /// scalar form's skipped edge pairs (edge of f missing face g) are masked off. On SSE2, 4 lanes:
 /// f's edges and face against g's face, f's corners against g's face, g's corners against f's
 /// face, and each edge of f against g's edges.
-inline FeatureOverlaps feature_overlaps(const FaceBoxes& a, const FaceBoxes& b) {
+[[gnu::always_inline]] inline FeatureOverlaps feature_overlaps(const FaceBoxes& a,
+                                                               const FaceBoxes& b) {
 #if defined(__SSE2__)
   const __m128 ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
   __m128 ae = ones, av = ones, bv = ones;  // f's edges vs g's face; f's / g's corners vs face
@@ -793,10 +794,9 @@ inline bool has_corner(const Face& t, int x) {
 
 /// Bit 3 i + j set for every i in `rows` and j in `cols` (3-bit masks).
 inline unsigned outer_bits(unsigned rows, unsigned cols) {
-  const unsigned spread_cols = cols * 0x49u;  // cols at bits 0, 3, 6
-  const unsigned spread_rows =
-      (rows & 1u) * 7u | ((rows >> 1) & 1u) * 0x38u | ((rows >> 2) & 1u) * 0x1c0u;
-  return spread_rows & spread_cols;
+  static constexpr unsigned short kRows[8] = {0x000, 0x007, 0x038, 0x03f,
+                                              0x1c0, 0x1c7, 0x1f8, 0x1ff};
+  return kRows[rows & 7u] & ((cols & 7u) * 0x49u);  // cols repeated at bits 0, 3, 6
 }
 
 /// Where ownership of a triangle pair (f, g)'s feature pairs needs the ordered search, in
@@ -820,50 +820,60 @@ inline FeatureOverlaps search_masks_scalar(const Ownership::FaceRecord& rf,
   return m;
 }
 
+#if defined(__SSE2__)
+namespace simd {
+// Four ints of record r from word `word` on.
+[[gnu::always_inline]] inline __m128i words(const Ownership::FaceRecord& r, int word) {
+  return _mm_loadu_si128(reinterpret_cast<const __m128i*>(reinterpret_cast<const int*>(&r) + word));
+}
+// One bit per lane (its sign bit).
+[[gnu::always_inline]] inline unsigned lane_bits(__m128i x) {
+  return static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(x)));
+}
+// Bit k: lane 2 k or 2 k + 1 set, of lanes 0..3 in m01 and 4..5 in m2 (lanes 0..1 there).
+[[gnu::always_inline]] inline unsigned either_of_pairs(unsigned m01, unsigned m2) {
+  return unsigned((m01 & 3u) != 0) | unsigned((m01 & 12u) != 0) << 1 |
+         unsigned((m2 & 3u) != 0) << 2;
+}
+}  // namespace simd
+#endif
+
 /// search_masks_scalar with SSE2 integer compares: each corner of one face against the other
 /// face's first-face corners and apexes four at a time, the apexes against each other by rows.
 /// Equality of ints, so the same bits.
-inline FeatureOverlaps search_masks(const Ownership::FaceRecord& rf,
-                                    const Ownership::FaceRecord& rg) {
+[[gnu::always_inline]] inline FeatureOverlaps search_masks(const Ownership::FaceRecord& rf,
+                                                           const Ownership::FaceRecord& rg) {
 #if defined(__SSE2__)
   static_assert(offsetof(Ownership::FaceRecord, other) == 24 &&
                 offsetof(Ownership::FaceRecord, apex) == 48 && sizeof(Ownership::FaceRecord) == 64);
-  const auto load = [](const Ownership::FaceRecord& r, int word) {
-    return _mm_loadu_si128(
-        reinterpret_cast<const __m128i*>(reinterpret_cast<const int*>(&r) + word));
-  };
-  const auto mask = [](__m128i x) {
-    return static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(x)));
-  };
   // Words 0..3: v[0..2], e[0]; 6..9: other[0], other[1]; 10..13: other[2], apex[0..1];
   // 12..15: apex[0..2], first. Lanes past the fields are masked off below.
-  const __m128i vf = load(rf, 0), vg = load(rg, 0);
-  const __m128i of01 = load(rf, 6), of2 = load(rf, 10), af = load(rf, 12);
-  const __m128i og01 = load(rg, 6), og2 = load(rg, 10), ag = load(rg, 12);
+  using simd::lane_bits, simd::words;
+  const __m128i vf = words(rf, 0), vg = words(rg, 0);
+  const __m128i of01 = words(rf, 6), of2 = words(rf, 10), af = words(rf, 12);
+  const __m128i og01 = words(rg, 6), og2 = words(rg, 10), ag = words(rg, 12);
   __m128i tf01 = _mm_setzero_si128(), tf2 = tf01, taf = tf01;  // ... equals a corner of g
   __m128i tg01 = tf01, tg2 = tf01, tag = tf01;                 // ... equals a corner of f
-  const auto corner = [&](__m128i cg, __m128i cf) {
+  const __m128i corners_g[3] = {_mm_shuffle_epi32(vg, 0x00), _mm_shuffle_epi32(vg, 0x55),
+                                _mm_shuffle_epi32(vg, 0xaa)};
+  const __m128i corners_f[3] = {_mm_shuffle_epi32(vf, 0x00), _mm_shuffle_epi32(vf, 0x55),
+                                _mm_shuffle_epi32(vf, 0xaa)};
+  for (int c = 0; c < 3; ++c) {
+    const __m128i cg = corners_g[c], cf = corners_f[c];
     tf01 = _mm_or_si128(tf01, _mm_cmpeq_epi32(of01, cg));
     tf2 = _mm_or_si128(tf2, _mm_cmpeq_epi32(of2, cg));
     taf = _mm_or_si128(taf, _mm_cmpeq_epi32(af, cg));
     tg01 = _mm_or_si128(tg01, _mm_cmpeq_epi32(og01, cf));
     tg2 = _mm_or_si128(tg2, _mm_cmpeq_epi32(og2, cf));
     tag = _mm_or_si128(tag, _mm_cmpeq_epi32(ag, cf));
-  };
-  corner(_mm_shuffle_epi32(vg, 0x00), _mm_shuffle_epi32(vf, 0x00));
-  corner(_mm_shuffle_epi32(vg, 0x55), _mm_shuffle_epi32(vf, 0x55));
-  corner(_mm_shuffle_epi32(vg, 0xaa), _mm_shuffle_epi32(vf, 0xaa));
-  const auto pairs = [](unsigned m01, unsigned m2) {  // other[k][0] or other[k][1] matched
-    return unsigned((m01 & 3u) != 0) | unsigned((m01 & 12u) != 0) << 1 |
-           unsigned((m2 & 3u) != 0) << 2;
-  };
+  }
   FeatureOverlaps m;
-  m.vf_f = pairs(mask(tf01), mask(tf2));
-  m.vf_g = pairs(mask(tg01), mask(tg2));
-  const unsigned same = (mask(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0x00))) & 7u) |
-                        (mask(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0x55))) & 7u) << 3 |
-                        (mask(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0xaa))) & 7u) << 6;
-  m.ee = outer_bits(mask(taf) & 7u, 7u) | outer_bits(7u, mask(tag) & 7u) | same;
+  m.vf_f = simd::either_of_pairs(lane_bits(tf01), lane_bits(tf2));
+  m.vf_g = simd::either_of_pairs(lane_bits(tg01), lane_bits(tg2));
+  const unsigned same = (lane_bits(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0x00))) & 7u) |
+                        (lane_bits(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0x55))) & 7u) << 3 |
+                        (lane_bits(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0xaa))) & 7u) << 6;
+  m.ee = outer_bits(lane_bits(taf) & 7u, 7u) | outer_bits(7u, lane_bits(tag) & 7u) | same;
   return m;
 #else
   return search_masks_scalar(rf, rg);
