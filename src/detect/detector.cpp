@@ -96,8 +96,9 @@ struct SelfDetector::Impl {
   bool restricted = false;
   bool outside = false;
   std::vector<std::uint8_t> face_active, vertex_active, edge_active, node_active;
-  // Swept boxes of the features, updated where vertices moved (see FeatureBoxes).
-  detail::FeatureBoxes boxes;
+  // Swept boxes of the features, updated where vertices moved (see FeatureBoxes), also gathered
+  // per face for the pair loop.
+  detail::FeatureBoxes boxes{true};
   // opt.linked_vertices normalized by the first detect() after construction or set_options (a
   // bad id throws there, and again at every call until the options change).
   std::vector<std::pair<int, int>> links;
@@ -263,55 +264,45 @@ struct SelfDetector::Impl {
     auto kee = [&](int a, int b, const Edge& ea, const Edge& eb, NarrowBuffer& out) {
       ctx.queue_ee(a, b, ea, eb, out.batch, out.c, out.ee);
     };
-    // The pair loop waits on memory: a triangle pair's records sit at scattered places of the
-    // box arrays. Fetch them ahead: the faces' records and boxes kFar pairs ahead, the boxes of
-    // their vertices and edges (found through those records) kNear pairs ahead.
-    constexpr std::size_t kFar = 16, kNear = 8;
+    // The pair loop waits on memory: a triangle pair's records and box blocks sit at scattered
+    // places. Fetch them kFar pairs ahead (a record is one cache line, a block three).
+    constexpr std::size_t kFar = 16;
     const auto fetch_face = [&](int f) {
       detail::prefetch(&owner.record(f));
-      detail::prefetch(&ctx.fboxes[f]);
+      const auto* block = reinterpret_cast<const char*>(&ctx.face_boxes[f]);
+      for (int line = 0; line < 3; ++line)
+        detail::prefetch(block + 64 * line);
     };
-    const auto fetch_features = [&](int f) {
-      const detail::Ownership::FaceRecord& r = owner.record(f);
-      for (int k = 0; k < 3; ++k) {
-        detail::prefetch(&ctx.vboxes[r.v[k]]);
-        detail::prefetch(&ctx.eboxes[r.e[k]]);
-      }
-    };
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        NarrowBuffer& out = locals.local();
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          if (i + kFar < pairs.size()) {
-                            fetch_face(pairs[i + kFar].first);
-                            fetch_face(pairs[i + kFar].second);
-                          }
-                          if (i + kNear < pairs.size()) {
-                            fetch_features(pairs[i + kNear].first);
-                            fetch_features(pairs[i + kNear].second);
-                          }
-                          const auto [f, g] = pairs[i];
-                          // Widened leaf boxes: no feature pair of faces whose own boxes miss.
-                          if (wide && !detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) {
-                            if (near != nullptr) {
-                              (*near)[i] =
-                                  !(detail::triangle_triangle_bound(detail::corners(v1, faces[f]),
-                                                                    detail::corners(v1, faces[g])) >
-                                    opt.reuse_distance);
-                            }
-                            continue;
-                          }
-                          ++out.c.triangle_pairs;
-                          double d1 = 0.0;
-                          const bool apart = ctx.faces_apart(f, g, near != nullptr ? &d1 : nullptr);
-                          if (near != nullptr) (*near)[i] = !(d1 > opt.reuse_distance);
-                          if (apart) {
-                            ++out.c.faces_apart;
-                            continue;
-                          }
-                          triangle_pair(ctx, f, g, out, kvf, kee);
-                        }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          NarrowBuffer& out = locals.local();
+          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (i + kFar < pairs.size()) {
+              fetch_face(pairs[i + kFar].first);
+              fetch_face(pairs[i + kFar].second);
+            }
+            const auto [f, g] = pairs[i];
+            // Widened leaf boxes: no feature pair of faces whose own boxes miss.
+            if (wide && !detail::overlap(ctx.face_boxes[f].face(), ctx.face_boxes[g].face())) {
+              if (near != nullptr) {
+                (*near)[i] = !(detail::triangle_triangle_bound(detail::corners(v1, faces[f]),
+                                                               detail::corners(v1, faces[g])) >
+                               opt.reuse_distance);
+              }
+              continue;
+            }
+            ++out.c.triangle_pairs;
+            double d1 = 0.0;
+            const bool apart = ctx.faces_apart(f, g, near != nullptr ? &d1 : nullptr);
+            if (near != nullptr) (*near)[i] = !(d1 > opt.reuse_distance);
+            if (apart) {
+              ++out.c.faces_apart;
+              continue;
+            }
+            triangle_pair(ctx, f, g, out, kvf, kee);
+          }
+        });
     for (auto& l : locals)  // at most one partial batch of each kind per thread
       ctx.flush(l.batch, l.c, l.vf, l.ee);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.vf.size(), 256),
@@ -351,12 +342,12 @@ struct SelfDetector::Impl {
   }
 
   // Tests the feature pairs of a non-adjacent triangle pair whose representative pair it is.
-  // Needs the context's precomputed boxes.
+  // Needs the context's precomputed boxes and face blocks (`boxes` keeps both).
   template <class Out, class KernelVf, class KernelEe>
   void triangle_pair(const detail::FeatureContext& ctx, int f, int g, Out& out, KernelVf&& kvf,
                      KernelEe&& kee) const {
     detail::owned_feature_pairs(
-        owner, detail::StepBoxes{ctx}, f, g,
+        owner, detail::StepFaceBoxes{ctx}, f, g,
         [&](int v, int face, const Face& t) {
           if (vf_in_scope(v, face)) kvf(v, face, t, out);
         },

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -17,6 +18,10 @@
 #include <span>
 #include <type_traits>
 #include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "ccd/face_bounds.hpp"
 #include "ccd/np_batch.hpp"
@@ -66,6 +71,33 @@ struct FeatureBatch {
   std::array<bool, kCapacity> miss;  // ccd_detail::fast_path_misses
 };
 
+/// One face's feature boxes for a step, side by side as float lanes: coordinate c of the boxes'
+/// lower corners in lo[c], of their upper corners in hi[c]. Lanes 0..2 hold the boxes of the
+/// face's edges (Topology::face_edges order), lane 3 the face's box, lanes 4..6 the boxes of its
+/// corners (Topology::faces order), lane 7 the face's box again. A triangle pair then reads two
+/// blocks of three cache lines instead of fourteen scattered boxes, and tests them four lanes at
+/// a time (feature_overlaps).
+struct alignas(64) FaceBoxes {
+  static constexpr int kEdges = 0, kFace = 3, kCorners = 4;
+  float lo[3][8], hi[3][8];
+
+  void set(int lane, const Box& b) {
+    for (int c = 0; c < 3; ++c) {
+      lo[c][lane] = b.lo[c];
+      hi[c][lane] = b.hi[c];
+    }
+  }
+  [[nodiscard]] Box get(int lane) const {
+    Box b;
+    for (int c = 0; c < 3; ++c) {
+      b.lo[c] = lo[c][lane];
+      b.hi[c] = hi[c][lane];
+    }
+    return b;
+  }
+  [[nodiscard]] Box face() const { return get(kFace); }
+};
+
 /// Positions of one step and the test settings.
 struct FeatureContext {
   const Topology* topo = nullptr;
@@ -77,6 +109,9 @@ struct FeatureContext {
   /// Optional swept boxes of every vertex, edge and face for this step (`precompute_boxes`);
   /// empty: computed on demand.
   std::span<const Box> vboxes, eboxes, fboxes;
+  /// Optional: the same boxes gathered per face (FeatureBoxes built with face blocks); empty
+  /// otherwise.
+  std::span<const FaceBoxes> face_boxes;
   /// DetectOptions::linked_vertices as (smaller, larger), sorted and unique (`sorted_links`).
   std::span<const std::pair<int, int>> links;
 
@@ -373,6 +408,10 @@ inline FeatureContext proximity_context(const Topology& topo, std::span<const Ei
 /// a pass on multilayer-rumba).
 class FeatureBoxes {
  public:
+  /// `face_blocks`: also keep each face's boxes gathered as a FaceBoxes (FeatureContext::
+  /// face_boxes), for the pair loop of owned_feature_pairs.
+  explicit FeatureBoxes(bool face_blocks = false) : blocks_on_(face_blocks) {}
+
   /// Brings the boxes up to date with ctx's positions and margin and points ctx at them. ctx's
   /// positions must be `step`'s current ones: when the boxes were last updated at the previous
   /// call of `step` with the same margin, only the features of its changed vertices are redone.
@@ -387,6 +426,7 @@ class FeatureBoxes {
       vboxes_.resize(nv);
       eboxes_.resize(topo.num_edges());
       fboxes_.resize(topo.num_faces());
+      if (blocks_on_) blocks_.resize(topo.num_faces());
     }
     const auto redo = [&](auto&& ids) {  // a vertex of the feature moved (or all did)
       if (moved.empty()) return true;
@@ -407,6 +447,23 @@ class FeatureBoxes {
     for_each(topo.num_faces(), [&](int f) {
       if (redo(topo.faces()[f])) fboxes_[f] = merged(topo.faces()[f]);
     });
+    if (blocks_on_) {
+      // A face's block holds its own, its edges' and its corners' boxes: copies, redone exactly
+      // when one of those is (a vertex of the face moved).
+      for_each(topo.num_faces(), [&](int f) {
+        const Face& t = topo.faces()[f];
+        if (!redo(t)) return;
+        FaceBoxes& b = blocks_[f];
+        const auto edges = topo.face_edges(f);
+        for (int k = 0; k < 3; ++k) {
+          b.set(FaceBoxes::kEdges + k, eboxes_[edges[k]]);
+          b.set(FaceBoxes::kCorners + k, vboxes_[t[k]]);
+        }
+        b.set(FaceBoxes::kFace, fboxes_[f]);
+        b.set(7, fboxes_[f]);
+      });
+      ctx.face_boxes = blocks_;
+    }
     ctx.vboxes = vboxes_;
     ctx.eboxes = eboxes_;
     ctx.fboxes = fboxes_;
@@ -434,7 +491,9 @@ class FeatureBoxes {
     });
   }
 
+  bool blocks_on_ = false;
   std::vector<Box> vboxes_, eboxes_, fboxes_;
+  std::vector<FaceBoxes> blocks_;
   std::uint64_t call_ = 0;  // the StepPositions call the boxes were computed at (0: none)
   double margin_ = -1.0;
 };
@@ -605,39 +664,229 @@ class Ownership {
   std::vector<FaceRecord> records_;
 };
 
+/// Which feature boxes of a triangle pair (f, g) overlap, in owned_feature_pairs' terms: bit k
+/// of `vf_f` vertex k of f against face g; of `vf_g` vertex k of g against face f; bit 3 i + j of
+/// `ee` edge i of f against edge j of g, set only where edge i of f also overlaps face g (the
+/// scalar test looks at the edge pairs of such edges alone).
+struct FeatureOverlaps {
+  unsigned vf_f = 0, vf_g = 0, ee = 0;
+  bool operator==(const FeatureOverlaps&) const = default;
+};
+
 /// A step's precomputed swept boxes (FeatureContext::vboxes, eboxes, fboxes) for
-/// owned_feature_pairs.
+/// owned_feature_pairs, one box test at a time.
 struct StepBoxes {
   const FeatureContext& ctx;
   [[nodiscard]] const Box& vertex(int v) const { return ctx.vboxes[v]; }
   [[nodiscard]] const Box& edge(int e) const { return ctx.eboxes[e]; }
   [[nodiscard]] const Box& face(int f) const { return ctx.fboxes[f]; }
+
+  /// The overlaps of (f, g), whose records are rf and rg.
+  template <class Record>
+  [[nodiscard]] FeatureOverlaps overlaps(const Record& rf, const Record& rg, int f, int g) const {
+    const Box& bf = face(f);
+    const Box& bg = face(g);
+    FeatureOverlaps o;
+    for (int k = 0; k < 3; ++k) {
+      o.vf_f |= unsigned(overlap(vertex(rf.v[k]), bg)) << k;
+      o.vf_g |= unsigned(overlap(vertex(rg.v[k]), bf)) << k;
+    }
+    for (int i = 0; i < 3; ++i) {
+      const Box& ba = edge(rf.e[i]);
+      if (!overlap(ba, bg)) continue;  // edge of f misses all of g
+      for (int j = 0; j < 3; ++j)
+        o.ee |= unsigned(overlap(ba, edge(rg.e[j]))) << (3 * i + j);
+    }
+    return o;
+  }
+};
+
+/// feature_overlaps lane by lane: the same float comparisons as StepBoxes::overlaps, on the
+/// copies of the same boxes (the reference the vector form is tested against).
+inline FeatureOverlaps feature_overlaps_scalar(const FaceBoxes& a, const FaceBoxes& b) {
+  FeatureOverlaps o;
+  const Box fa = a.face(), fb = b.face();
+  for (int k = 0; k < 3; ++k) {
+    o.vf_f |= unsigned(overlap(a.get(FaceBoxes::kCorners + k), fb)) << k;
+    o.vf_g |= unsigned(overlap(b.get(FaceBoxes::kCorners + k), fa)) << k;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const Box ea = a.get(FaceBoxes::kEdges + i);
+    if (!overlap(ea, fb)) continue;
+    for (int j = 0; j < 3; ++j)
+      o.ee |= unsigned(overlap(ea, b.get(FaceBoxes::kEdges + j))) << (3 * i + j);
+  }
+  return o;
+}
+
+/// The overlaps of a triangle pair from the faces' blocks a (of f) and b (of g): StepBoxes::
+/// overlaps' answer exactly. The blocks hold copies of the same float boxes, and each lane
+/// makes the same two comparisons per axis as overlap(FeatureBox, FeatureBox), lo <= hi of the
+/// other box both ways (ordered, so false on NaN as the scalar `<=`), ANDed over the axes; the
+/// scalar form's skipped edge pairs (edge of f missing face g) are masked off. On SSE2, 4 lanes:
+/// f's edges and face against g's face, f's corners against g's face, g's corners against f's
+/// face, and each edge of f against g's edges.
+[[gnu::always_inline]] inline FeatureOverlaps feature_overlaps(const FaceBoxes& a,
+                                                               const FaceBoxes& b) {
+#if defined(__SSE2__)
+  const __m128 ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  __m128 ae = ones, av = ones, bv = ones;  // f's edges vs g's face; f's / g's corners vs face
+  __m128 ee[3] = {ones, ones, ones};       // edge i of f vs g's edges
+  for (int c = 0; c < 3; ++c) {
+    const __m128 alo = _mm_load_ps(a.lo[c]), ahi = _mm_load_ps(a.hi[c]);
+    const __m128 blo = _mm_load_ps(b.lo[c]), bhi = _mm_load_ps(b.hi[c]);
+    const __m128 avlo = _mm_load_ps(a.lo[c] + 4), avhi = _mm_load_ps(a.hi[c] + 4);
+    const __m128 bvlo = _mm_load_ps(b.lo[c] + 4), bvhi = _mm_load_ps(b.hi[c] + 4);
+    const __m128 aflo = _mm_shuffle_ps(alo, alo, _MM_SHUFFLE(3, 3, 3, 3));
+    const __m128 afhi = _mm_shuffle_ps(ahi, ahi, _MM_SHUFFLE(3, 3, 3, 3));
+    const __m128 bflo = _mm_shuffle_ps(blo, blo, _MM_SHUFFLE(3, 3, 3, 3));
+    const __m128 bfhi = _mm_shuffle_ps(bhi, bhi, _MM_SHUFFLE(3, 3, 3, 3));
+    ae = _mm_and_ps(ae, _mm_and_ps(_mm_cmple_ps(alo, bfhi), _mm_cmple_ps(bflo, ahi)));
+    av = _mm_and_ps(av, _mm_and_ps(_mm_cmple_ps(avlo, bfhi), _mm_cmple_ps(bflo, avhi)));
+    bv = _mm_and_ps(bv, _mm_and_ps(_mm_cmple_ps(bvlo, afhi), _mm_cmple_ps(aflo, bvhi)));
+    const __m128 lo0 = _mm_shuffle_ps(alo, alo, _MM_SHUFFLE(0, 0, 0, 0));
+    const __m128 hi0 = _mm_shuffle_ps(ahi, ahi, _MM_SHUFFLE(0, 0, 0, 0));
+    const __m128 lo1 = _mm_shuffle_ps(alo, alo, _MM_SHUFFLE(1, 1, 1, 1));
+    const __m128 hi1 = _mm_shuffle_ps(ahi, ahi, _MM_SHUFFLE(1, 1, 1, 1));
+    const __m128 lo2 = _mm_shuffle_ps(alo, alo, _MM_SHUFFLE(2, 2, 2, 2));
+    const __m128 hi2 = _mm_shuffle_ps(ahi, ahi, _MM_SHUFFLE(2, 2, 2, 2));
+    ee[0] = _mm_and_ps(ee[0], _mm_and_ps(_mm_cmple_ps(lo0, bhi), _mm_cmple_ps(blo, hi0)));
+    ee[1] = _mm_and_ps(ee[1], _mm_and_ps(_mm_cmple_ps(lo1, bhi), _mm_cmple_ps(blo, hi1)));
+    ee[2] = _mm_and_ps(ee[2], _mm_and_ps(_mm_cmple_ps(lo2, bhi), _mm_cmple_ps(blo, hi2)));
+  }
+  const unsigned edges = static_cast<unsigned>(_mm_movemask_ps(ae));
+  FeatureOverlaps o;
+  o.vf_f = static_cast<unsigned>(_mm_movemask_ps(av)) & 7u;
+  o.vf_g = static_cast<unsigned>(_mm_movemask_ps(bv)) & 7u;
+  for (int i = 0; i < 3; ++i) {
+    const unsigned row = static_cast<unsigned>(_mm_movemask_ps(ee[i])) & 7u;
+    o.ee |= (((edges >> i) & 1u) != 0 ? row : 0u) << (3 * i);
+  }
+  return o;
+#else
+  return feature_overlaps_scalar(a, b);
+#endif
+}
+
+/// A step's boxes gathered per face (FeatureContext::face_boxes) for owned_feature_pairs: the
+/// same overlaps as StepBoxes, several box tests per instruction.
+struct StepFaceBoxes {
+  const FeatureContext& ctx;
+  template <class Record>
+  [[nodiscard]] FeatureOverlaps overlaps(const Record&, const Record&, int f, int g) const {
+    return feature_overlaps(ctx.face_boxes[f], ctx.face_boxes[g]);
+  }
 };
 
 /// No geometry for owned_feature_pairs: every box overlaps every other, so it yields every
 /// feature pair the triangle pair owns.
 struct NoBoxes {
-  struct Any {};
-  [[nodiscard]] Any vertex(int) const { return {}; }
-  [[nodiscard]] Any edge(int) const { return {}; }
-  [[nodiscard]] Any face(int) const { return {}; }
+  template <class Record>
+  [[nodiscard]] FeatureOverlaps overlaps(const Record&, const Record&, int, int) const {
+    return {7u, 7u, 0x1ffu};
+  }
 };
-inline bool overlap(NoBoxes::Any, NoBoxes::Any) {
-  return true;
-}
 
 /// Whether x is a corner of t.
 inline bool has_corner(const Face& t, int x) {
   return x == t[0] || x == t[1] || x == t[2];
 }
 
+/// Bit 3 i + j set for every i in `rows` and j in `cols` (3-bit masks).
+inline unsigned outer_bits(unsigned rows, unsigned cols) {
+  static constexpr unsigned short kRows[8] = {0x000, 0x007, 0x038, 0x03f,
+                                              0x1c0, 0x1c7, 0x1f8, 0x1ff};
+  return kRows[rows & 7u] & ((cols & 7u) * 0x49u);  // cols repeated at bits 0, 3, 6
+}
+
+/// Where ownership of a triangle pair (f, g)'s feature pairs needs the ordered search, in
+/// FeatureOverlaps' bit layout, from the faces' records rf and rg (see owned_feature_pairs): VF
+/// bit k, when a corner of g (of f) is one of the two other corners of the first face of f's (g's)
+/// corner k; EE bit 3 i + j, when the apex wb of edge j of g is a corner of f, the apex wa of edge
+/// i of f a corner of g, or wa == wb. Lane by lane, the reference of search_masks.
+inline FeatureOverlaps search_masks_scalar(const Ownership::FaceRecord& rf,
+                                           const Ownership::FaceRecord& rg) {
+  FeatureOverlaps m;
+  for (int k = 0; k < 3; ++k) {
+    m.vf_f |= unsigned(has_corner(rg.v, rf.other[k][0]) || has_corner(rg.v, rf.other[k][1])) << k;
+    m.vf_g |= unsigned(has_corner(rf.v, rg.other[k][0]) || has_corner(rf.v, rg.other[k][1])) << k;
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const int wa = rf.apex[i], wb = rg.apex[j];
+      m.ee |= unsigned(has_corner(rf.v, wb) || has_corner(rg.v, wa) || wa == wb) << (3 * i + j);
+    }
+  }
+  return m;
+}
+
+#if defined(__SSE2__)
+namespace simd {
+// Four ints of record r from word `word` on.
+[[gnu::always_inline]] inline __m128i words(const Ownership::FaceRecord& r, int word) {
+  return _mm_loadu_si128(reinterpret_cast<const __m128i*>(reinterpret_cast<const int*>(&r) + word));
+}
+// One bit per lane (its sign bit).
+[[gnu::always_inline]] inline unsigned lane_bits(__m128i x) {
+  return static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(x)));
+}
+// Bit k: lane 2 k or 2 k + 1 set, of lanes 0..3 in m01 and 4..5 in m2 (lanes 0..1 there).
+[[gnu::always_inline]] inline unsigned either_of_pairs(unsigned m01, unsigned m2) {
+  return unsigned((m01 & 3u) != 0) | unsigned((m01 & 12u) != 0) << 1 |
+         unsigned((m2 & 3u) != 0) << 2;
+}
+}  // namespace simd
+#endif
+
+/// search_masks_scalar with SSE2 integer compares: each corner of one face against the other
+/// face's first-face corners and apexes four at a time, the apexes against each other by rows.
+/// Equality of ints, so the same bits.
+[[gnu::always_inline]] inline FeatureOverlaps search_masks(const Ownership::FaceRecord& rf,
+                                                           const Ownership::FaceRecord& rg) {
+#if defined(__SSE2__)
+  static_assert(offsetof(Ownership::FaceRecord, other) == 24 &&
+                offsetof(Ownership::FaceRecord, apex) == 48 && sizeof(Ownership::FaceRecord) == 64);
+  // Words 0..3: v[0..2], e[0]; 6..9: other[0], other[1]; 10..13: other[2], apex[0..1];
+  // 12..15: apex[0..2], first. Lanes past the fields are masked off below.
+  using simd::lane_bits, simd::words;
+  const __m128i vf = words(rf, 0), vg = words(rg, 0);
+  const __m128i of01 = words(rf, 6), of2 = words(rf, 10), af = words(rf, 12);
+  const __m128i og01 = words(rg, 6), og2 = words(rg, 10), ag = words(rg, 12);
+  __m128i tf01 = _mm_setzero_si128(), tf2 = tf01, taf = tf01;  // ... equals a corner of g
+  __m128i tg01 = tf01, tg2 = tf01, tag = tf01;                 // ... equals a corner of f
+  const __m128i corners_g[3] = {_mm_shuffle_epi32(vg, 0x00), _mm_shuffle_epi32(vg, 0x55),
+                                _mm_shuffle_epi32(vg, 0xaa)};
+  const __m128i corners_f[3] = {_mm_shuffle_epi32(vf, 0x00), _mm_shuffle_epi32(vf, 0x55),
+                                _mm_shuffle_epi32(vf, 0xaa)};
+  for (int c = 0; c < 3; ++c) {
+    const __m128i cg = corners_g[c], cf = corners_f[c];
+    tf01 = _mm_or_si128(tf01, _mm_cmpeq_epi32(of01, cg));
+    tf2 = _mm_or_si128(tf2, _mm_cmpeq_epi32(of2, cg));
+    taf = _mm_or_si128(taf, _mm_cmpeq_epi32(af, cg));
+    tg01 = _mm_or_si128(tg01, _mm_cmpeq_epi32(og01, cf));
+    tg2 = _mm_or_si128(tg2, _mm_cmpeq_epi32(og2, cf));
+    tag = _mm_or_si128(tag, _mm_cmpeq_epi32(ag, cf));
+  }
+  FeatureOverlaps m;
+  m.vf_f = simd::either_of_pairs(lane_bits(tf01), lane_bits(tf2));
+  m.vf_g = simd::either_of_pairs(lane_bits(tg01), lane_bits(tg2));
+  const unsigned same = (lane_bits(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0x00))) & 7u) |
+                        (lane_bits(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0x55))) & 7u) << 3 |
+                        (lane_bits(_mm_cmpeq_epi32(ag, _mm_shuffle_epi32(af, 0xaa))) & 7u) << 6;
+  m.ee = outer_bits(lane_bits(taf) & 7u, 7u) | outer_bits(7u, lane_bits(tag) & 7u) | same;
+  return m;
+#else
+  return search_masks_scalar(rf, rg);
+#endif
+}
+
 /// The feature pairs of the triangle pair (f, g), sharing no vertex, whose R-triangle pair it is
 /// (docs/algorithms.md 6.3) and whose boxes overlap: vf(v, face, corners of face) for a vertex of
 /// one face against the other, ee(e1, e2, vertices of e1, vertices of e2) with e1 < e2 for an edge
-/// of each. Box tests first (cheap, they reject most), then ownership from the faces' records:
-/// a set bit of `first` settles it; otherwise the first candidate of the ordered search owns the
-/// pair, and it is not (f, g), unless that candidate touches the other face, and the records tell
-/// when it can:
+/// of each. Box tests first (cheap, they reject most: `boxes.overlaps`, see FeatureOverlaps),
+/// then ownership from the faces' records: a set bit of `first` settles it; otherwise the first
+/// candidate of the ordered search owns the pair, and it is not (f, g), unless that candidate
+/// touches the other face, and the records tell when it can (search_masks):
 ///  - VF (v of f, against g): the search starts at v's first face h, which is not f. h holds v,
 ///    which g lacks, so h touches g exactly when one of h's other two corners is in g.
 ///  - EE (edge a of f, edge b of g): the search starts at the edges' first faces ha = a + wa and
@@ -650,51 +899,38 @@ void owned_feature_pairs(const Ownership& owner, const Boxes& boxes, int f, int 
                          Ee&& ee) {
   const Ownership::FaceRecord& rf = owner.record(f);
   const Ownership::FaceRecord& rg = owner.record(g);
-  const auto& bf = boxes.face(f);
-  const auto& bg = boxes.face(g);
+  const FeatureOverlaps o = boxes.overlaps(rf, rg, f, g);
+  if ((o.vf_f | o.vf_g | o.ee) == 0) return;
+  const FeatureOverlaps search = search_masks(rf, rg);
   const unsigned mf = rf.first, mg = rg.first;
-  for (int k = 0; k < 3; ++k) {
+  // Owned outright: first faces of the vertex, of both edges.
+  const unsigned first_ee = outer_bits((mf >> 3) & 7u, (mg >> 3) & 7u);
+  for (unsigned bits = o.vf_f & ((mf & 7u) | search.vf_f); bits != 0; bits &= bits - 1) {
+    const int k = std::countr_zero(bits);
     const int v = rf.v[k];
-    if (!overlap(boxes.vertex(v), bg)) continue;
-    if (!((mf >> k) & 1u) &&
-        !((has_corner(rg.v, rf.other[k][0]) || has_corner(rg.v, rf.other[k][1])) &&
-          owner.owns_vf(v, g, f))) {
-      continue;
-    }
+    if (!((mf >> k) & 1u) && !owner.owns_vf(v, g, f)) continue;
     vf(v, g, rg.v);
   }
-  for (int k = 0; k < 3; ++k) {
+  for (unsigned bits = o.vf_g & ((mg & 7u) | search.vf_g); bits != 0; bits &= bits - 1) {
+    const int k = std::countr_zero(bits);
     const int v = rg.v[k];
-    if (!overlap(boxes.vertex(v), bf)) continue;
-    if (!((mg >> k) & 1u) &&
-        !((has_corner(rf.v, rg.other[k][0]) || has_corner(rf.v, rg.other[k][1])) &&
-          owner.owns_vf(v, f, g))) {
-      continue;
-    }
+    if (!((mg >> k) & 1u) && !owner.owns_vf(v, f, g)) continue;
     vf(v, f, rf.v);
   }
-  using B = std::decay_t<decltype(boxes.edge(0))>;
-  const B bg_edges[3] = {boxes.edge(rg.e[0]), boxes.edge(rg.e[1]), boxes.edge(rg.e[2])};
-  for (int i = 0; i < 3; ++i) {
-    const B& ba = boxes.edge(rf.e[i]);
-    if (!overlap(ba, bg)) continue;  // edge of f misses all of g
-    for (int j = 0; j < 3; ++j) {
-      if (!overlap(ba, bg_edges[j])) continue;
-      const int ea = rf.e[i], eb = rg.e[j];
-      const bool a_first = ea < eb;
-      const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;
-      bool mine = (mf >> (3 + i)) & (mg >> (3 + j)) & 1u;
-      if (!mine) {
-        const int wa = rf.apex[i], wb = rg.apex[j];
-        mine = (has_corner(rf.v, wb) || has_corner(rg.v, wa) || wa == wb) &&
-               (a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f));
-      }
-      if (!mine) continue;
-      if (a_first) {
-        ee(e1, e2, rf.edge(i), rg.edge(j));
-      } else {
-        ee(e1, e2, rg.edge(j), rf.edge(i));
-      }
+  for (unsigned bits = o.ee & (first_ee | search.ee); bits != 0; bits &= bits - 1) {
+    const int n = std::countr_zero(bits);
+    const int i = n / 3, j = n % 3;
+    const int ea = rf.e[i], eb = rg.e[j];
+    const bool a_first = ea < eb;
+    const int e1 = a_first ? ea : eb, e2 = a_first ? eb : ea;
+    if (!((first_ee >> n) & 1u) &&
+        !(a_first ? owner.owns_ee(e1, e2, f, g) : owner.owns_ee(e1, e2, g, f))) {
+      continue;
+    }
+    if (a_first) {
+      ee(e1, e2, rf.edge(i), rg.edge(j));
+    } else {
+      ee(e1, e2, rg.edge(j), rf.edge(i));
     }
   }
 }
