@@ -8,6 +8,7 @@
 // fails and the memory stays on normal pages.
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdlib>
 #include <new>
@@ -34,8 +35,9 @@ namespace {
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kLarge = 2 * kHugePage;
 
-void* allocate(std::size_t n) {
-  if (n >= kLarge) {
+// `align`: 0 for plain new, else the alignment asked for (a power of two).
+void* allocate(std::size_t n, std::size_t align) {
+  if (n >= kLarge && align <= kHugePage) {
     const std::size_t rounded = (n + kHugePage - 1) / kHugePage * kHugePage;
     if (void* p = std::aligned_alloc(kHugePage, rounded)) {
       madvise(p, rounded, MADV_HUGEPAGE);
@@ -43,18 +45,60 @@ void* allocate(std::size_t n) {
     }
     return nullptr;
   }
-  return std::malloc(n == 0 ? 1 : n);
+  if (align == 0) return std::malloc(n == 0 ? 1 : n);
+  // aligned_alloc wants a size that is a multiple of the alignment.
+  return std::aligned_alloc(align, (std::max<std::size_t>(n, 1) + align - 1) / align * align);
+}
+
+void* allocate_or_throw(std::size_t n, std::size_t align) {
+  for (;;) {
+    if (void* p = allocate(n, align)) return p;
+    std::new_handler h = std::get_new_handler();
+    if (h == nullptr) throw std::bad_alloc();
+    h();
+  }
 }
 
 }  // namespace
 
 void* operator new(std::size_t n) {
-  for (;;) {
-    if (void* p = allocate(n)) return p;
-    std::new_handler h = std::get_new_handler();
-    if (h == nullptr) throw std::bad_alloc();
-    h();
+  return allocate_or_throw(n, 0);
+}
+
+// Over-aligned types (alignas above 16) come here: the per-face box blocks of the narrow phase.
+void* operator new(std::size_t n, std::align_val_t a) {
+  return allocate_or_throw(n, static_cast<std::size_t>(a));
+}
+void* operator new[](std::size_t n, std::align_val_t a) {
+  return operator new(n, a);
+}
+void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  try {
+    return operator new(n, a);
+  } catch (...) {
+    return nullptr;
   }
+}
+void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
+  return operator new(n, a, std::nothrow);
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept {
+  std::free(p);
 }
 
 void* operator new[](std::size_t n) {
