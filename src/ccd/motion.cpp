@@ -51,7 +51,7 @@ Motion make_motion(const std::array<const Eigen::Vector3d*, 8>& points) {
   out.largest = m;
   out.scale_exponent = -binade_exponent(m);
   if (out.scale_exponent <= DBL_MAX_EXP - 1) {
-    const double scale = out.scale = inverse_binade(m);
+    const double scale = out.scale = power_of_two(out.scale_exponent);
     fill_scaled(out, points, [scale](double x) { return x * scale; });
   } else {
     // Every coordinate is below 2^-1023, and 2^scale_exponent is no double: std::ldexp scales
@@ -72,13 +72,16 @@ int binade_exponent(double m) {
   return e;
 }
 
-double inverse_binade(double m) {
-  // 2^-e built from bits where it is normal; ldexp elsewhere.
-  const int e = binade_exponent(m);
-  if (-e >= DBL_MIN_EXP - 1 && -e <= DBL_MAX_EXP - 1) {
-    return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - e) << 52);
+double power_of_two(int k) {
+  // Built from bits where 2^k is normal; ldexp elsewhere.
+  if (k >= DBL_MIN_EXP - 1 && k <= DBL_MAX_EXP - 1) {
+    return std::bit_cast<double>(static_cast<std::uint64_t>(1023 + k) << 52);
   }
-  return std::ldexp(1.0, -e);
+  return std::ldexp(1.0, k);
+}
+
+double inverse_binade(double m) {
+  return power_of_two(-binade_exponent(m));
 }
 
 }  // namespace clothcd::ccd_detail

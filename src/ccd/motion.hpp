@@ -30,6 +30,9 @@ Motion make_motion(const std::array<const Eigen::Vector3d*, 8>& points);
 /// std::frexp's exponent of m (m = f 2^e, f in [0.5, 1)); 0 for m == 0.
 int binade_exponent(double m);
 
+/// 2^k (infinity above 2^1023).
+double power_of_two(int k);
+
 /// The scale make_motion applies for a largest |coordinate| m (finite, >= 0): 2^-e with m 2^-e in
 /// [0.5, 1) (std::frexp's e), 1 for m == 0.
 double inverse_binade(double m);

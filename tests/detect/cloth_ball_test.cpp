@@ -4,12 +4,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <fstream>
 #include <set>
 
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "support/data.hpp"
+#include "support/json_file.hpp"
 
 namespace clothcd {
 namespace {
@@ -19,10 +19,7 @@ struct GroundTruth {
   std::vector<std::pair<int, int>> ee;  // (edge, edge), ascending
 };
 
-nlohmann::json read_json(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
+using test::read_json;
 
 GroundTruth positives(const std::filesystem::path& root, int nv, int ne) {
   GroundTruth gt;

@@ -11,8 +11,20 @@
 #include <vector>
 
 #include "detect/narrow.hpp"
+#include "detect/step_positions.hpp"
 
 namespace clothcd::face_boxes_check {
+
+/// The context of `step`'s current positions with the boxes' margin only (no CCD settings).
+inline detail::FeatureContext step_context(const Topology& topo, const detail::StepPositions& step,
+                                           double margin) {
+  detail::FeatureContext ctx;
+  ctx.topo = &topo;
+  ctx.v0 = step.x0();
+  ctx.v1 = step.x1();
+  ctx.margin = margin;
+  return ctx;
+}
 
 // One yielded feature pair: (0, vertex, face) or (1, edge, edge).
 using Yield = std::tuple<int, int, int>;

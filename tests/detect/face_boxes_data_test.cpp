@@ -7,7 +7,6 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <fstream>
 #include <span>
 #include <vector>
 
@@ -15,14 +14,12 @@
 #include "detect/step_positions.hpp"
 #include "face_boxes_check.hpp"
 #include "support/data.hpp"
+#include "support/json_file.hpp"
 
 namespace clothcd::face_boxes_data_test {
 namespace {
 
-nlohmann::json read_json(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
+using test::read_json;
 
 TEST(FaceBoxes, SameFeaturePairsAsTheSeparateBoxesOnClothBall) {
   CLOTHCD_REQUIRE_DATA(root, "cloth-ball");
@@ -62,11 +59,7 @@ TEST(FaceBoxes, SameFeaturePairsAsTheSeparateBoxesOnClothBall) {
               "t1");
   for (double margin : {0.0, 5e-4}) {
     SCOPED_TRACE(::testing::Message() << "margin " << margin);
-    detail::FeatureContext ctx;
-    ctx.topo = &t;
-    ctx.v0 = step.x0();
-    ctx.v1 = step.x1();
-    ctx.margin = margin;
+    detail::FeatureContext ctx = face_boxes_check::step_context(t, step, margin);
     boxes.update(ctx, step);
     face_boxes_check::expect_blocks(ctx);
     std::size_t n = 0;

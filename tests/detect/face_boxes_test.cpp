@@ -70,11 +70,7 @@ std::size_t check_mesh(const std::vector<Face>& faces, std::vector<Eigen::Vector
   for (double margin : {0.0, 0.0, 1e-3, 1e-3}) {
     step.update(std::span<const Eigen::Vector3d>(v0), std::span<const Eigen::Vector3d>(v1), nv,
                 "t0", "t1");
-    detail::FeatureContext ctx;
-    ctx.topo = &topo;
-    ctx.v0 = step.x0();
-    ctx.v1 = step.x1();
-    ctx.margin = margin;
+    detail::FeatureContext ctx = face_boxes_check::step_context(topo, step, margin);
     boxes.update(ctx, step);
     face_boxes_check::expect_blocks(ctx);
     for (int f = 0; f < topo.num_faces(); ++f) {
@@ -135,14 +131,7 @@ TEST(FaceBoxes, SearchMasksEqualTheScalarFormOnRandomMeshes) {
     const int nv = gen.integer(8, 24);
     std::vector<Face> faces;
     for (int i = gen.integer(4, 40); i > 0; --i) {
-      Face t{};
-      t[0] = gen.integer(0, nv - 1);
-      do {
-        t[1] = gen.integer(0, nv - 1);
-      } while (t[1] == t[0]);
-      do {
-        t[2] = gen.integer(0, nv - 1);
-      } while (t[2] == t[0] || t[2] == t[1]);
+      const Face t = gen.face(nv);
       faces.push_back(t);
     }
     const Topology topo(faces, nv);

@@ -14,6 +14,7 @@
 #include "clothcd/detect/procedural.hpp"
 #include "detect/narrow.hpp"
 #include "detect/step_positions.hpp"
+#include "face_boxes_check.hpp"
 
 namespace clothcd {
 namespace {
@@ -52,11 +53,7 @@ TEST(FeatureBoxes, EqualEachFeaturesOwnSweptBox) {
   for (double margin : {0.0, 5e-6, 5e-4}) {
     SCOPED_TRACE(::testing::Message() << "margin " << margin);
     call();
-    detail::FeatureContext ctx;
-    ctx.topo = &topo;
-    ctx.v0 = step.x0();
-    ctx.v1 = step.x1();
-    ctx.margin = margin;
+    detail::FeatureContext ctx = face_boxes_check::step_context(topo, step, margin);
     boxes.update(ctx, step);
     expect_own_boxes(ctx);
     // A few vertices move: only their features' boxes are redone, and all still agree.

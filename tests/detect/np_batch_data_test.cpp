@@ -8,20 +8,17 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <fstream>
 #include <span>
 
 #include "clothcd/mesh/io.hpp"
 #include "detect/narrow.hpp"
 #include "support/data.hpp"
+#include "support/json_file.hpp"
 
 namespace clothcd::np_batch_data_test {
 namespace {
 
-nlohmann::json read_json(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return nlohmann::json::parse(in);
-}
+using test::read_json;
 
 struct Candidates {
   std::vector<std::pair<int, int>> vf, ee;  // (vertex, face), (edge, edge) with edge ids < ...

@@ -35,14 +35,7 @@ TEST(Ownership, RecordsAgreeWithTheDefinitionOnRandomMeshes) {
     const int nf = gen.integer(4, 40);
     std::vector<Face> faces;
     for (int i = 0; i < nf; ++i) {
-      Face t{};
-      t[0] = gen.integer(0, nv - 1);
-      do {
-        t[1] = gen.integer(0, nv - 1);
-      } while (t[1] == t[0]);
-      do {
-        t[2] = gen.integer(0, nv - 1);
-      } while (t[2] == t[0] || t[2] == t[1]);
+      const Face t = gen.face(nv);
       faces.push_back(t);
       if (gen.integer(0, 9) == 0) faces.push_back({t[2], t[0], t[1]});  // a duplicate
     }
