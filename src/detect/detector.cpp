@@ -183,36 +183,37 @@ struct SelfDetector::Impl {
     return !restricted || ((edge_active[ea] != 0 || edge_active[eb] != 0) != outside);
   }
 
+  // Whether the self test of internal node i is skipped under `mode` (the cones of the last
+  // refit): counts the cone and contour tests it makes.
+  bool culls(Rule mode, int i, detail::TraversalCounters& c) const {
+    if (!cones_used(mode)) return false;
+    const BvhNode& n = bvh.nodes()[i];
+    if (mode == Rule::Gated && !n.connected()) return false;
+    if (mode == Rule::Sound && (!n.disk() || n.count < opt.cull_min_triangles)) return false;
+    ++c.cone_tests;
+    const NormalCone& k = bvh.cones()[i];
+    if (!(k.half_angle < std::numbers::pi / 2 - kConeMargin)) return false;
+    if (mode != Rule::Sound) return true;
+    ++c.contour_tests;
+    // The star test is O(contour); the general simplicity test catches what it cannot.
+    bool ok = detail::contour_star_shaped(bvh.contour(i), v0, v1, k.axis) ||
+              detail::contour_simple(bvh.contour(i), v0, v1, k.axis);
+    if (ok && culls_with_reach()) {
+      // Projected distances are at least cos(half angle) times the 3-D corner clearances.
+      const double reach = cull_reach(n);
+      const double cosine = std::cos(k.half_angle);
+      ok = corners_clear(n, cosine, reach) &&
+           detail::contour_clear(bvh.contour(i), v0, v1, k.axis, reach);
+    }
+    if (!ok) ++c.contour_fails;
+    return ok;
+  }
+
   // Overlapping non-adjacent leaf pairs of the culled self traversal.
   std::vector<std::pair<int, int>> traverse(Rule mode, DetectStats& st) {
     const auto& nodes = bvh.nodes();
     const auto& prims = bvh.prim_ids();
-    const auto& cones = bvh.cones();
-    const bool use_cones = cones_used(mode);
-    const bool with_reach = mode == Rule::Sound && culls_with_reach();
-    auto cull = [&](int i, detail::TraversalCounters& c) {
-      if (!use_cones) return false;
-      const BvhNode& n = nodes[i];
-      if (mode == Rule::Gated && !n.connected()) return false;
-      if (mode == Rule::Sound && (!n.disk() || n.count < opt.cull_min_triangles)) return false;
-      ++c.cone_tests;
-      const NormalCone& k = cones[i];
-      if (!(k.half_angle < std::numbers::pi / 2 - kConeMargin)) return false;
-      if (mode != Rule::Sound) return true;
-      ++c.contour_tests;
-      // The star test is O(contour); the general simplicity test catches what it cannot.
-      bool ok = detail::contour_star_shaped(bvh.contour(i), v0, v1, k.axis) ||
-                detail::contour_simple(bvh.contour(i), v0, v1, k.axis);
-      if (ok && with_reach) {
-        // Projected distances are at least cos(half angle) times the 3-D corner clearances.
-        const double reach = cull_reach(n);
-        const double cosine = std::cos(k.half_angle);
-        ok = corners_clear(n, cosine, reach) &&
-             detail::contour_clear(bvh.contour(i), v0, v1, k.axis, reach);
-      }
-      if (!ok) ++c.contour_fails;
-      return ok;
-    };
+    auto cull = [&](int i, detail::TraversalCounters& c) { return culls(mode, i, c); };
     // Plain pointers: the output's stores could otherwise alias the containers.
     auto leaf = [np = nodes.data(), pp = prims.data(), fp = topo.faces().data()](int a, int b,
                                                                                  PairBuffer& out) {
@@ -250,11 +251,23 @@ struct SelfDetector::Impl {
     return detail::ccd_context(topo, v0, v1, opt, links);
   }
 
+  using NarrowLocals = tbb::enumerable_thread_specific<NarrowBuffer>;
+
   // The feature pairs of `pairs` and of the orphans that collide (ctx's boxes are up to date).
   // With `near`, also flags the pairs whose faces are at most opt.reuse_distance apart at t1.
   void narrow(const detail::FeatureContext& ctx, const std::vector<std::pair<int, int>>& pairs,
               DetectResult& res, std::vector<std::uint8_t>* near = nullptr) {
-    tbb::enumerable_thread_specific<NarrowBuffer> locals;
+    NarrowLocals locals;
+    narrow_pairs(ctx, pairs, locals, near);
+    narrow_orphans(ctx, locals);
+    res.stats.triangle_pairs = 0;
+    gather(locals, res);
+    finish(res);
+  }
+
+  // The feature pairs of the triangle pairs `pairs` that collide, into `locals`.
+  void narrow_pairs(const detail::FeatureContext& ctx, std::span<const std::pair<int, int>> pairs,
+                    NarrowLocals& locals, std::vector<std::uint8_t>* near = nullptr) const {
     const bool wide = box_reach() > opt.thickness;
     if (near != nullptr) near->assign(pairs.size(), 0);
     const auto& faces = topo.faces();
@@ -305,6 +318,10 @@ struct SelfDetector::Impl {
         });
     for (auto& l : locals)  // at most one partial batch of each kind per thread
       ctx.flush(l.batch, l.c, l.vf, l.ee);
+  }
+
+  // The orphan feature pairs that collide, into `locals`.
+  void narrow_orphans(const detail::FeatureContext& ctx, NarrowLocals& locals) const {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.vf.size(), 256),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         NarrowBuffer& out = locals.local();
@@ -325,16 +342,24 @@ struct SelfDetector::Impl {
                           ctx.kernel_ee(ea, eb, out.c, out.ee);
                         }
                       });
+  }
+
+  // Adds the buffers' counters and collisions to `res` (left unsorted).
+  static void gather(const NarrowLocals& locals, DetectResult& res) {
     DetectStats& st = res.stats;
-    st.triangle_pairs = 0;
-    st.vf_orphans = orphans.vf.size();
-    st.ee_orphans = orphans.ee.size();
-    for (auto& l : locals) {
+    for (const auto& l : locals) {
       l.c.add_to(st);
       st.triangle_pairs += l.c.triangle_pairs;
       res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
       res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
     }
+  }
+
+  // Sorts the collisions and counts them, and the orphans every detection checks.
+  void finish(DetectResult& res) const {
+    DetectStats& st = res.stats;
+    st.vf_orphans = orphans.vf.size();
+    st.ee_orphans = orphans.ee.size();
     std::sort(res.vf.begin(), res.vf.end(), detail::vf_less);
     std::sort(res.ee.begin(), res.ee.end(), detail::ee_less);
     st.vf_collisions = res.vf.size();
@@ -356,15 +381,10 @@ struct SelfDetector::Impl {
         });
   }
 
-  DetectResult detect(detail::PointsIn p0, detail::PointsIn p1) {
-    step.update(p0, p1, topo.num_vertices(), "positions at t0", "positions at t1");
-    if (!links_current) {
-      links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
-      links_current = true;
-    }
-    DetectResult res;
-    DetectStats& st = res.stats;
-    auto t = Clock::now();
+  // Boxes and cones for the current options, where vertices moved since the last refit (all of
+  // it when the refit options changed).
+  void refit(DetectStats& st) {
+    const auto t = Clock::now();
     RefitOptions ro;
     ro.thickness = box_reach();
     ro.cones = cones_used(rule());
@@ -378,8 +398,226 @@ struct SelfDetector::Impl {
     st.internal_nodes = bvh.num_internal();
     st.connected_internal_nodes = bvh.num_connected_internal();
     st.disk_internal_nodes = bvh.num_disk_internal();
+  }
 
-    t = Clock::now();
+  // SelfDetector::detect_each. The self traversal without culling is the union, over the
+  // internal nodes n, of the pair traversals of n's two children: every leaf pair below n whose
+  // leaves lie on either side of the split. A culling rule removes exactly the pair traversals
+  // of the nodes it culls and of their descendants. So each configuration walks its rule over
+  // the nodes (refit to its cones), which marks the nodes whose pair traversal it keeps; the
+  // nodes are grouped by the set of configurations that keep them; and each group's pair
+  // traversals and narrow phase run once, their counters and collisions going to every
+  // configuration of its set.
+  std::vector<DetectResult> detect_each(detail::PointsIn p0, detail::PointsIn p1,
+                                        std::span<const DetectOptions> configs) {
+    constexpr std::size_t kMaxConfigs = 64;
+    if (configs.size() > kMaxConfigs) {
+      throw InputError(
+          fmt::format("detect_each: {} configurations, at most {}", configs.size(), kMaxConfigs));
+    }
+    if (restricted) throw InputError("detect_each: clear the active restriction first");
+    // Everything but the culling and the cones must match: boxes, kernels and links are shared.
+    auto shared_part = [](DetectOptions o) {
+      o.policy = {};
+      o.culling = {};
+      o.build = {};
+      o.cull_min_triangles = 0;
+      o.research.unsound_culling = {};
+      o.research.optimal_cones = false;
+      return o;
+    };
+    for (std::size_t k = 0; k < configs.size(); ++k) {
+      const DetectOptions& c = configs[k];
+      check_options(c);
+      if (c.reuse_distance != 0 || c.research.verify) {
+        throw InputError(fmt::format(
+            "detect_each: configuration {} sets reuse_distance or verify (both must be off)", k));
+      }
+      if (!(shared_part(c) == shared_part(configs[0]))) {
+        throw InputError(fmt::format(
+            "detect_each: configuration {} differs from the first in more than its policy, "
+            "culling, cull_min_triangles, unsound culling or optimal cones",
+            k));
+      }
+    }
+    std::vector<DetectResult> out(configs.size());
+    if (configs.empty()) return out;
+    // The caller's options come back however this ends.
+    struct Restore {
+      Impl& im;
+      DetectOptions saved;
+      ~Restore() {
+        im.opt = std::move(saved);
+        im.links_current = false;
+      }
+    } restore{*this, opt};
+    reuse.valid = false;
+    step.update(p0, p1, topo.num_vertices(), "positions at t0", "positions at t1");
+    opt = configs[0];
+    opt.build = restore.saved.build;
+    links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
+    links_current = true;
+
+    // Each configuration's rule over the nodes: bit k of keep[n] when the self test of internal
+    // node n runs under configs[k], so that the pair traversal of n's children does.
+    const auto& nodes = bvh.nodes();
+    std::vector<std::uint64_t> keep(nodes.size(), 0);
+    std::vector<int> stack;
+    for (std::size_t k = 0; k < configs.size(); ++k) {
+      opt = configs[k];
+      opt.build = restore.saved.build;
+      DetectStats& st = out[k].stats;
+      refit(st);
+      const Rule mode = rule();
+      detail::TraversalCounters c;
+      if (!nodes.empty()) stack.assign(1, 0);
+      while (!stack.empty()) {
+        const int i = stack.back();
+        stack.pop_back();
+        if (nodes[i].is_leaf()) continue;
+        if (culls(mode, i, c)) {
+          ++c.culled;
+          continue;
+        }
+        keep[i] |= std::uint64_t{1} << k;
+        stack.push_back(nodes[i].left + 1);
+        stack.push_back(nodes[i].left);
+      }
+      st.nodes_culled = c.culled;
+      st.cone_tests = c.cone_tests;
+      st.contour_tests = c.contour_tests;
+      st.contour_fails = c.contour_fails;
+      st.time_traverse = std::nan("");
+      st.time_narrow = std::nan("");
+    }
+
+    // Groups: the distinct sets of configurations, and the pair traversals of each group's nodes.
+    std::vector<std::uint64_t> sets;
+    std::vector<int> group(nodes.size(), -1);
+    for (std::size_t n = 0; n < nodes.size(); ++n) {
+      if (keep[n] == 0) continue;
+      auto it = std::find(sets.begin(), sets.end(), keep[n]);
+      group[n] = static_cast<int>(it - sets.begin());
+      if (it == sets.end()) sets.push_back(keep[n]);
+    }
+    const std::size_t ng = sets.size();
+    struct GroupPairs {
+      std::vector<std::pair<int, int>> pairs;
+      std::uint64_t adjacent = 0, box_tests = 0;
+    };
+    struct Local {
+      int g = 0;  // the group of the pair traversal running
+      std::vector<GroupPairs> groups;
+    };
+    auto no_cull = [](int, detail::TraversalCounters&) { return false; };
+    auto leaf = [np = nodes.data(), pp = bvh.prim_ids().data(), fp = topo.faces().data()](
+                    int a, int b, Local& out) {
+      GroupPairs& gp = out.groups[out.g];
+      const int fa = pp[np[a].first], fb = pp[np[b].first];
+      if (faces_touch(fp[fa], fp[fb])) {
+        ++gp.adjacent;
+        return;
+      }
+      gp.pairs.emplace_back(fa, fb);
+    };
+    auto tr = detail::make_traversal(nodes, nodes, {}, {}, no_cull, leaf);
+    tbb::enumerable_thread_specific<Local> locals([ng] {
+      Local l;
+      l.groups.resize(ng);
+      return l;
+    });
+    // Each kept node's pair traversal, those of large nodes split a few levels first (as
+    // run_parallel splits the root) so that the threads share them.
+    std::vector<std::pair<detail::Task, int>> tasks;
+    {
+      Local& serial = locals.local();
+      const int big = std::max(64, topo.num_faces() / 64);
+      std::vector<std::pair<detail::Task, int>> todo;
+      for (std::size_t n = 0; n < nodes.size(); ++n) {
+        if (group[n] >= 0)
+          todo.emplace_back(detail::Task{nodes[n].left, nodes[n].left + 1, false}, group[n]);
+      }
+      while (!todo.empty()) {
+        const auto [t, g] = todo.back();
+        todo.pop_back();
+        if (std::min(nodes[t.a].count, nodes[t.b].count) <= big) {
+          tasks.emplace_back(t, g);
+          continue;
+        }
+        // step() tests the pair's boxes and leaves its children untested: run() tests them.
+        detail::TraversalCounters c;
+        serial.g = g;
+        tr.step(t, c, serial, [&](const detail::Task& s) { todo.emplace_back(s, g); });
+        serial.groups[static_cast<std::size_t>(g)].box_tests += c.box_tests;
+      }
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tasks.size(), 8),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        Local& l = locals.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const auto& [t, g] = tasks[i];
+                          detail::TraversalCounters c;
+                          l.g = g;
+                          tr.run(t, c, l);
+                          l.groups[static_cast<std::size_t>(g)].box_tests += c.box_tests;
+                        }
+                      });
+
+    // The narrow phase of each group, then the orphans, which every configuration checks.
+    detail::FeatureContext ctx = ccd_context();
+    boxes.update(ctx, step);
+    std::vector<DetectResult> found(ng);
+    for (std::size_t g = 0; g < ng; ++g) {
+      NarrowLocals narrow_locals;
+      for (Local& l : locals) {
+        GroupPairs& gp = l.groups[g];
+        found[g].stats.box_tests += gp.box_tests;
+        found[g].stats.adjacent_pairs += gp.adjacent;
+        narrow_pairs(ctx, gp.pairs, narrow_locals);
+        std::vector<std::pair<int, int>>().swap(gp.pairs);
+      }
+      gather(narrow_locals, found[g]);
+    }
+    DetectResult orphan_hits;
+    {
+      NarrowLocals narrow_locals;
+      narrow_orphans(ctx, narrow_locals);
+      gather(narrow_locals, orphan_hits);
+    }
+    auto add = [](const DetectResult& from, DetectResult& to) {
+      DetectStats& s = to.stats;
+      const DetectStats& f = from.stats;
+      s.box_tests += f.box_tests;
+      s.adjacent_pairs += f.adjacent_pairs;
+      s.triangle_pairs += f.triangle_pairs;
+      s.triangle_pairs_apart += f.triangle_pairs_apart;
+      s.vf_tests += f.vf_tests;
+      s.ee_tests += f.ee_tests;
+      s.vf_np_culled += f.vf_np_culled;
+      s.ee_np_culled += f.ee_np_culled;
+      to.vf.insert(to.vf.end(), from.vf.begin(), from.vf.end());
+      to.ee.insert(to.ee.end(), from.ee.begin(), from.ee.end());
+    };
+    for (std::size_t k = 0; k < configs.size(); ++k) {
+      for (std::size_t g = 0; g < ng; ++g) {
+        if ((sets[g] >> k) & 1U) add(found[g], out[k]);
+      }
+      add(orphan_hits, out[k]);
+      finish(out[k]);
+    }
+    return out;
+  }
+
+  DetectResult detect(detail::PointsIn p0, detail::PointsIn p1) {
+    step.update(p0, p1, topo.num_vertices(), "positions at t0", "positions at t1");
+    if (!links_current) {
+      links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
+      links_current = true;
+    }
+    DetectResult res;
+    DetectStats& st = res.stats;
+    refit(st);
+    auto t = Clock::now();
     auto pairs = traverse(rule(), st);
     st.time_traverse = seconds_since(t);
     t = Clock::now();
@@ -594,6 +832,15 @@ DetectResult SelfDetector::detect(const Positions& v_t0, const Positions& v_t1) 
 DetectResult SelfDetector::detect(std::span<const Eigen::Vector3d> v_t0,
                                   std::span<const Eigen::Vector3d> v_t1) {
   return impl_->detect(v_t0, v_t1);
+}
+std::vector<DetectResult> SelfDetector::detect_each(const Positions& v_t0, const Positions& v_t1,
+                                                    std::span<const DetectOptions> configs) {
+  return impl_->detect_each(v_t0, v_t1, configs);
+}
+std::vector<DetectResult> SelfDetector::detect_each(std::span<const Eigen::Vector3d> v_t0,
+                                                    std::span<const Eigen::Vector3d> v_t1,
+                                                    std::span<const DetectOptions> configs) {
+  return impl_->detect_each(v_t0, v_t1, configs);
 }
 ProximityResult SelfDetector::proximity(const Positions& v, double h) {
   return impl_->proximity(v, h);

@@ -62,7 +62,7 @@ double quantile(std::vector<double> v, double q) {
 
 struct Agg {
   int calls = 0;
-  std::vector<double> pairs, vf, ee, culled, refit, cd, total;
+  std::vector<double> pairs, vf, ee, culled;
   double missed_vf = 0, missed_ee = 0, extra = 0, ref_vf = 0, ref_ee = 0;
   int steps_missing = 0;
 };
@@ -142,9 +142,6 @@ SceneData collect(const Sequence& seq, const ExperimentOptions& opt) {
     a.vf.push_back(r.vf_tests);
     a.ee.push_back(r.ee_tests);
     a.culled.push_back(r.nodes_culled);
-    a.refit.push_back(r.ms_refit);
-    a.cd.push_back(r.ms_cd());
-    a.total.push_back(r.ms_total());
     a.missed_vf += r.missed_vf;
     a.missed_ee += r.missed_ee;
     a.extra += r.extra_vf + r.extra_ee;
@@ -261,17 +258,47 @@ std::string table1(const std::vector<SceneData>& data, const ExperimentOptions& 
   return s;
 }
 
+// Per (build, culling, policy, threads): the totals of the timing pass and, paired call by call
+// (same step, repeat and thread count), the ratio to PROVOT under the same rule.
+struct TimingAgg {
+  std::vector<double> total, refit, cd, ratio;
+  std::map<int, std::vector<double>> step_totals;  ///< the repeats of each timed step
+};
+using TimingKey = std::tuple<std::string, std::string, std::string, int>;
+
+std::map<TimingKey, TimingAgg> timing_aggs(const SceneData& d) {
+  std::map<std::tuple<std::string, std::string, int, int, int>, double> provot;
+  for (const auto& r : d.timing) {
+    if (r.policy == "PROVOT")
+      provot[{r.build, r.culling, r.step, r.repeat, r.threads}] = r.ms_total();
+  }
+  std::map<TimingKey, TimingAgg> out;
+  for (const auto& r : d.timing) {
+    TimingAgg& a = out[{r.build, r.culling, r.policy, r.threads}];
+    a.total.push_back(r.ms_total());
+    a.step_totals[r.step].push_back(r.ms_total());
+    a.refit.push_back(r.ms_refit);
+    a.cd.push_back(r.ms_traverse + r.ms_narrow);
+    const auto it = provot.find({r.build, r.culling, r.step, r.repeat, r.threads});
+    if (r.culling != "none" && it != provot.end() && it->second > 0) {
+      a.ratio.push_back(r.ms_total() / it->second);
+    }
+  }
+  return out;
+}
+
 std::string table2(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
   std::string s =
       "# Table 2: average time per CD call (ms)\n\n"
       "refit = swept boxes + normal cones (the paper's \"BVH construction\"; ours refits a tree "
       "built once), CD = self traversal + narrow phase (VF/EE tests with the NP filter and the "
       "CCD kernels), total = refit + CD; *vs PROVOT* = 1 - total / PROVOT's total under the "
-      "same build and culling rule. Means as in the paper, plus the median of the total. All "
-      "configurations of a step run back to back on the same frames, so machine noise is "
-      "shared; compare within a scene. These are single calls (one per configuration and "
-      "step): indicative. The figures to quote are in timing.md (medians over repeated, "
-      "interleaved calls at 1 and 2 threads, with their spread and the load).\n\n"
+      "same build, culling rule and thread count. Means over the calls of the timing pass, as "
+      "the paper gives means, plus the median of the total: the CD calls it times (see "
+      "timing.md), each configuration repeated and interleaved with the others on the same "
+      "frames, at each thread count. Compare within a scene; timing.md gives the spreads, the "
+      "machine's load and the ratios paired call by call. The counting pass (Table 1) "
+      "measures no time: it counts all configurations of a call with one narrow phase.\n\n"
       "### The paper (Han et al. 2021, Table 2; Intel Core i9-9900)\n\n"
       "| scene | BVH PROVOT | BVH PROPOSED | CD PROVOT | CD PROPOSED | total PROVOT | total "
       "PROPOSED | reduction |\n|---|---|---|---|---|---|---|---|\n";
@@ -286,20 +313,24 @@ std::string table2(const std::vector<SceneData>& data, const ExperimentOptions& 
   s += fmt::format("| average | | | | | | | {} (the paper states 18.24%) |\n\n",
                    pct(red_sum / std::size(kPaper)));
   for (const auto& d : data) {
+    if (d.timing.empty()) continue;
     s += scene_heading(d, opt);
-    s += "| build | culling | policy | calls | refit | CD | total | median total | vs PROVOT "
-         "|\n|---|---|---|---|---|---|---|---|---|\n";
+    s += "| build | culling | policy | threads | calls | refit | CD | total | median total | vs "
+         "PROVOT |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    const auto agg = timing_aggs(d);
     for (const auto& k : config_order(opt)) {
-      const auto it = d.agg.find(k);
-      if (it == d.agg.end()) continue;
-      const Agg& a = it->second;
-      const auto base = d.agg.find({k.build, k.culling, "PROVOT"});
-      s += fmt::format("| {} | {} | {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} |\n", k.build,
-                       k.culling, k.policy, a.calls, mean(a.refit), mean(a.cd), mean(a.total),
-                       median(a.total),
-                       base != d.agg.end() && k.culling != "none"
-                           ? pct(reduction(mean(a.total), mean(base->second.total)))
-                           : "-");
+      for (int t = 1; t <= 1024; ++t) {
+        const auto it = agg.find({k.build, k.culling, k.policy, t});
+        if (it == agg.end()) continue;
+        const TimingAgg& a = it->second;
+        const auto base = agg.find({k.build, k.culling, "PROVOT", t});
+        s += fmt::format("| {} | {} | {} | {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} |\n",
+                         k.build, k.culling, k.policy, t, a.total.size(), mean(a.refit), mean(a.cd),
+                         mean(a.total), median(a.total),
+                         base != agg.end() && k.culling != "none"
+                             ? pct(reduction(mean(a.total), mean(base->second.total)))
+                             : "-");
+      }
     }
     s += "\n";
   }
@@ -404,35 +435,6 @@ std::string spread_table(const std::vector<SceneData>& data, const ExperimentOpt
     s += "\n";
   }
   return s;
-}
-
-// Per (build, culling, policy, threads): the totals of the timing pass and, paired call by call
-// (same step, repeat and thread count), the ratio to PROVOT under the same rule.
-struct TimingAgg {
-  std::vector<double> total, refit, cd, ratio;
-  std::map<int, std::vector<double>> step_totals;  ///< the repeats of each timed step
-};
-using TimingKey = std::tuple<std::string, std::string, std::string, int>;
-
-std::map<TimingKey, TimingAgg> timing_aggs(const SceneData& d) {
-  std::map<std::tuple<std::string, std::string, int, int, int>, double> provot;
-  for (const auto& r : d.timing) {
-    if (r.policy == "PROVOT")
-      provot[{r.build, r.culling, r.step, r.repeat, r.threads}] = r.ms_total();
-  }
-  std::map<TimingKey, TimingAgg> out;
-  for (const auto& r : d.timing) {
-    TimingAgg& a = out[{r.build, r.culling, r.policy, r.threads}];
-    a.total.push_back(r.ms_total());
-    a.step_totals[r.step].push_back(r.ms_total());
-    a.refit.push_back(r.ms_refit);
-    a.cd.push_back(r.ms_traverse + r.ms_narrow);
-    const auto it = provot.find({r.build, r.culling, r.step, r.repeat, r.threads});
-    if (r.culling != "none" && it != provot.end() && it->second > 0) {
-      a.ratio.push_back(r.ms_total() / it->second);
-    }
-  }
-  return out;
 }
 
 // A figure is flagged noisy when the same call, repeated, varies by more than a fifth of its
@@ -555,19 +557,18 @@ std::string sequences_table(const std::vector<SceneData>& data, const Experiment
 std::string summary(const std::vector<SceneData>& data, const ExperimentOptions& opt) {
   std::string s =
       "# Summary: PROPOSED and EXACT against PROVOT\n\n"
-      "Per scene, BVH build and culling rule: the reduction in triangle pair tests and in mean "
-      "total time per CD call (1 - X / PROVOT, positive = fewer / faster; from table1.md and "
-      "table2.md), and the collisions each policy missed against the unculled reference, summed "
-      "over the calls (from misses.md). *time* is the single timed call per configuration and "
-      "step of the counting pass (indicative); *timed 1 / 2 thr* is 1 - the median ratio to "
-      "PROVOT of the timing pass (timing.md, repeated interleaved calls, 1 and 2 threads; "
-      "`*` = noisy there). Spread angles relative to OPTIMAL: spread.md.\n\n"
+      "Per scene, BVH build and culling rule: the reduction in triangle pair tests per CD call "
+      "(1 - X / PROVOT, positive = fewer; table1.md), in time (*timed 1 / 2 thr*: 1 - the "
+      "median ratio to PROVOT's total in the timing pass, paired call by call at 1 and 2 "
+      "threads; timing.md, `*` = noisy there, `-` = the rule was not timed), and the collisions "
+      "each policy missed against the unculled reference, summed over the calls (misses.md). "
+      "Spread angles relative to OPTIMAL: spread.md.\n\n"
       "## The sequences\n\n" +
       sequences_table(data, opt) +
       "## PROPOSED and EXACT against PROVOT\n\n"
-      "| scene | calls | build | rule | pairs PROPOSED | pairs EXACT | time PROPOSED | time EXACT "
-      "| timed PROPOSED 1 / 2 thr | missed PROVOT / PROPOSED / EXACT (of reference) "
-      "|\n|---|---|---|---|---|---|---|---|---|---|\n";
+      "| scene | calls | build | rule | pairs PROPOSED | pairs EXACT | timed PROPOSED 1 / 2 thr "
+      "| timed EXACT 1 / 2 thr | missed PROVOT / PROPOSED / EXACT (of reference) "
+      "|\n|---|---|---|---|---|---|---|---|---|\n";
   auto find = [](const SceneData& d, const ConfigKey& k) -> const Agg* {
     const auto it = d.agg.find(k);
     return it == d.agg.end() ? nullptr : &it->second;
@@ -578,8 +579,8 @@ std::string summary(const std::vector<SceneData>& data, const ExperimentOptions&
       for (CullingRule c : opt.cullings) {
         if (c == CullingRule::None) continue;
         const std::string bn = build_name(b), cn = culling_name(c);
-        auto timed = [&](int t) -> std::string {
-          const auto it = tagg.find({bn, cn, "PROPOSED", t});
+        auto timed = [&](const char* policy, int t) -> std::string {
+          const auto it = tagg.find({bn, cn, policy, t});
           if (it == tagg.end() || it->second.ratio.empty()) return "-";
           return pct(1.0 - median(it->second.ratio)) + (noisy(it->second.ratio) ? "*" : "");
         };
@@ -590,16 +591,16 @@ std::string summary(const std::vector<SceneData>& data, const ExperimentOptions&
           return a != nullptr ? pct(reduction(mean(field(*a)), mean(field(*base)))) : "-";
         };
         auto pairs = [](const Agg& a) { return a.pairs; };
-        auto total = [](const Agg& a) { return a.total; };
         auto missed = [&](const char* policy) -> std::string {
           const Agg* a = find(d, {bn, cn, policy});
           return a != nullptr ? grouped(a->missed_vf + a->missed_ee) : "-";
         };
         s += fmt::format(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} / {} / {} (of {}) |\n",
+            "| {} | {} | {} | {} | {} | {} | {} / {} | {} / {} | {} / {} / {} (of {}) |\n",
             d.seq->name, base->calls, bn, cn, red("PROPOSED", pairs), red("EXACT", pairs),
-            red("PROPOSED", total), red("EXACT", total), timed(1), timed(2), missed("PROVOT"),
-            missed("PROPOSED"), missed("EXACT"), grouped(base->ref_vf + base->ref_ee));
+            timed("PROPOSED", 1), timed("PROPOSED", 2), timed("EXACT", 1), timed("EXACT", 2),
+            missed("PROVOT"), missed("PROPOSED"), missed("EXACT"),
+            grouped(base->ref_vf + base->ref_ee));
       }
     }
   }

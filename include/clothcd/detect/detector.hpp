@@ -96,6 +96,24 @@ class SelfDetector {
   void rebuild(const Positions& reference);
   void rebuild(std::span<const Eigen::Vector3d> reference);
 
+  /// The step v_t0 -> v_t1 under each of several options, for measuring culling rules and cone
+  /// policies against each other (the experiment's counting pass). Result k holds what
+  /// set_options(configs[k]) followed by detect() reports: the same collisions and the same
+  /// counters of DetectStats. The work differs: every configuration refits its cones and walks
+  /// its culling rule over the nodes, but the node pairs' box tests and the narrow phase run
+  /// once, over the pairs that some configuration keeps, each pair's results counted for the
+  /// configurations that keep it. time_refit is each configuration's own refit; time_traverse
+  /// and time_narrow are NaN (shared work; detect() measures them). The configurations may
+  /// differ only in policy, culling, cull_min_triangles and the research options'
+  /// unsound_culling and optimal_cones (their build is ignored, as set_options ignores it);
+  /// reuse_distance must be 0, verify off, at most 64 of them and no active restriction.
+  /// Throws InputError otherwise. The detector's own options are left as they were.
+  [[nodiscard]] std::vector<DetectResult> detect_each(const Positions& v_t0, const Positions& v_t1,
+                                                      std::span<const DetectOptions> configs);
+  [[nodiscard]] std::vector<DetectResult> detect_each(std::span<const Eigen::Vector3d> v_t0,
+                                                      std::span<const Eigen::Vector3d> v_t1,
+                                                      std::span<const DetectOptions> configs);
+
   [[nodiscard]] const DetectOptions& options() const;
   void set_options(const DetectOptions& options);  ///< the BVH build stays as constructed
   [[nodiscard]] const Topology& topology() const;

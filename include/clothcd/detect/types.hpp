@@ -65,6 +65,7 @@ struct DetectOptions {
   /// For measuring the paper's rules; a simulator leaves it at its default (see
   /// clothcd/research/options.hpp: unsound culling rules, optimal cones, verification).
   research::Options research;
+  bool operator==(const DetectOptions&) const = default;
 };
 
 /// Counters and times of one detection call (times in seconds).

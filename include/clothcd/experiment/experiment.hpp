@@ -69,7 +69,10 @@ struct TimingRow {
 
 /// One CD call of one configuration. `policy` is "-" for the unculled reference (culling none).
 /// Counts are the detector's DetectStats; missed = in the reference's pair set and not in this
-/// configuration's, extra = the converse (exact (vertex, face) / (edge, edge) sets).
+/// configuration's, extra = the converse (exact (vertex, face) / (edge, edge) sets). The counting
+/// pass runs all configurations of a call in one SelfDetector::detect_each: ms_refit is the
+/// configuration's own refit, ms_traverse and ms_narrow are NaN (shared work; TimingRow has the
+/// times).
 struct StepRow {
   std::string scene, build, culling, policy;
   int step = 0;
