@@ -538,7 +538,10 @@ struct SelfDetector::Impl {
           todo.emplace_back(detail::Task{nodes[n].left, nodes[n].left + 1, false}, group[n]);
       }
       while (!todo.empty()) {
-        const auto [t, g] = todo.back();
+        // Named copies: a lambda below captures g (not a structured binding: C++20 compilers
+        // differ on capturing those).
+        const detail::Task t = todo.back().first;
+        const int g = todo.back().second;
         todo.pop_back();
         if (std::min(nodes[t.a].count, nodes[t.b].count) <= big) {
           tasks.emplace_back(t, g);
