@@ -400,6 +400,61 @@ struct SelfDetector::Impl {
     st.disk_internal_nodes = bvh.num_disk_internal();
   }
 
+  // detect_each's walk of each configuration's rule over the nodes: refits to its cones (the
+  // detector's options become configs[k], built as `build`), counts the rule's tests into
+  // out[k].stats, and sets bit k of the result's entry n when the self test of internal node n
+  // runs under configs[k], so that the pair traversal of n's children does.
+  std::vector<std::uint64_t> kept_nodes(std::span<const DetectOptions> configs, BvhBuild build,
+                                        std::vector<DetectResult>& out) {
+    const auto& nodes = bvh.nodes();
+    std::vector<std::uint64_t> keep(nodes.size(), 0);
+    std::vector<int> stack;
+    for (std::size_t k = 0; k < configs.size(); ++k) {
+      opt = configs[k];
+      opt.build = build;
+      DetectStats& st = out[k].stats;
+      refit(st);
+      const Rule mode = rule();
+      detail::TraversalCounters c;
+      if (!nodes.empty()) stack.assign(1, 0);
+      while (!stack.empty()) {
+        const int i = stack.back();
+        stack.pop_back();
+        if (nodes[i].is_leaf()) continue;
+        if (culls(mode, i, c)) {
+          ++c.culled;
+          continue;
+        }
+        keep[i] |= std::uint64_t{1} << k;
+        stack.push_back(nodes[i].left + 1);
+        stack.push_back(nodes[i].left);
+      }
+      st.nodes_culled = c.culled;
+      st.cone_tests = c.cone_tests;
+      st.contour_tests = c.contour_tests;
+      st.contour_fails = c.contour_fails;
+      st.time_traverse = std::nan("");
+      st.time_narrow = std::nan("");
+    }
+    return keep;
+  }
+
+  // Adds the shared work's counters and collisions (a group's or the orphans') to a result.
+  static void add_shared(const DetectResult& from, DetectResult& to) {
+    DetectStats& s = to.stats;
+    const DetectStats& f = from.stats;
+    s.box_tests += f.box_tests;
+    s.adjacent_pairs += f.adjacent_pairs;
+    s.triangle_pairs += f.triangle_pairs;
+    s.triangle_pairs_apart += f.triangle_pairs_apart;
+    s.vf_tests += f.vf_tests;
+    s.ee_tests += f.ee_tests;
+    s.vf_np_culled += f.vf_np_culled;
+    s.ee_np_culled += f.ee_np_culled;
+    to.vf.insert(to.vf.end(), from.vf.begin(), from.vf.end());
+    to.ee.insert(to.ee.end(), from.ee.begin(), from.ee.end());
+  }
+
   // SelfDetector::detect_each. The self traversal without culling is the union, over the
   // internal nodes n, of the pair traversals of n's two children: every leaf pair below n whose
   // leaves lie on either side of the split. A culling rule removes exactly the pair traversals
@@ -458,38 +513,8 @@ struct SelfDetector::Impl {
     links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
     links_current = true;
 
-    // Each configuration's rule over the nodes: bit k of keep[n] when the self test of internal
-    // node n runs under configs[k], so that the pair traversal of n's children does.
+    const std::vector<std::uint64_t> keep = kept_nodes(configs, restore.saved.build, out);
     const auto& nodes = bvh.nodes();
-    std::vector<std::uint64_t> keep(nodes.size(), 0);
-    std::vector<int> stack;
-    for (std::size_t k = 0; k < configs.size(); ++k) {
-      opt = configs[k];
-      opt.build = restore.saved.build;
-      DetectStats& st = out[k].stats;
-      refit(st);
-      const Rule mode = rule();
-      detail::TraversalCounters c;
-      if (!nodes.empty()) stack.assign(1, 0);
-      while (!stack.empty()) {
-        const int i = stack.back();
-        stack.pop_back();
-        if (nodes[i].is_leaf()) continue;
-        if (culls(mode, i, c)) {
-          ++c.culled;
-          continue;
-        }
-        keep[i] |= std::uint64_t{1} << k;
-        stack.push_back(nodes[i].left + 1);
-        stack.push_back(nodes[i].left);
-      }
-      st.nodes_culled = c.culled;
-      st.cone_tests = c.cone_tests;
-      st.contour_tests = c.contour_tests;
-      st.contour_fails = c.contour_fails;
-      st.time_traverse = std::nan("");
-      st.time_narrow = std::nan("");
-    }
 
     // Groups: the distinct sets of configurations, and the pair traversals of each group's nodes.
     std::vector<std::uint64_t> sets;
@@ -587,25 +612,11 @@ struct SelfDetector::Impl {
       narrow_orphans(ctx, narrow_locals);
       gather(narrow_locals, orphan_hits);
     }
-    auto add = [](const DetectResult& from, DetectResult& to) {
-      DetectStats& s = to.stats;
-      const DetectStats& f = from.stats;
-      s.box_tests += f.box_tests;
-      s.adjacent_pairs += f.adjacent_pairs;
-      s.triangle_pairs += f.triangle_pairs;
-      s.triangle_pairs_apart += f.triangle_pairs_apart;
-      s.vf_tests += f.vf_tests;
-      s.ee_tests += f.ee_tests;
-      s.vf_np_culled += f.vf_np_culled;
-      s.ee_np_culled += f.ee_np_culled;
-      to.vf.insert(to.vf.end(), from.vf.begin(), from.vf.end());
-      to.ee.insert(to.ee.end(), from.ee.begin(), from.ee.end());
-    };
     for (std::size_t k = 0; k < configs.size(); ++k) {
       for (std::size_t g = 0; g < ng; ++g) {
-        if ((sets[g] >> k) & 1U) add(found[g], out[k]);
+        if ((sets[g] >> k) & 1U) add_shared(found[g], out[k]);
       }
-      add(orphan_hits, out[k]);
+      add_shared(orphan_hits, out[k]);
       finish(out[k]);
     }
     return out;
