@@ -20,6 +20,7 @@
 #include "clothcd/detect/oracle.hpp"
 #include "clothcd/detect/procedural.hpp"
 #include "clothcd/research/names.hpp"
+#include "support/detect_stats.hpp"
 
 namespace clothcd {
 namespace {
@@ -255,27 +256,7 @@ TEST(DetectApi, RebuiltDetectorEqualsBruteForce) {
   EXPECT_GT(changed, 0);  // so the node comparison above shows a rebuild, not the old tree
 }
 
-// Every counter of a detection (times excluded).
-std::vector<std::uint64_t> counters(const DetectStats& s) {
-  return {s.box_tests,
-          s.nodes_culled,
-          s.cone_tests,
-          s.contour_tests,
-          s.contour_fails,
-          std::uint64_t(s.internal_nodes),
-          std::uint64_t(s.connected_internal_nodes),
-          std::uint64_t(s.disk_internal_nodes),
-          s.adjacent_pairs,
-          s.triangle_pairs,
-          s.vf_tests,
-          s.ee_tests,
-          s.vf_np_culled,
-          s.ee_np_culled,
-          s.vf_orphans,
-          s.ee_orphans,
-          s.vf_collisions,
-          s.ee_collisions};
-}
+using test::counters;
 
 TEST(DetectApi, DeterministicOnOneTwoAndFourThreads) {
   const ProceduralScene s = crumpled_sheet(16, 5);

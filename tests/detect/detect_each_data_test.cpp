@@ -7,8 +7,8 @@
 #include "clothcd/detect/names.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/research/names.hpp"
-#include "detect_each_check.hpp"
 #include "support/data.hpp"
+#include "support/detect_stats.hpp"
 
 namespace clothcd {
 namespace {
