@@ -12,6 +12,8 @@ void np_filter_batch_sse2(Kind kind, const NpBatch& b, NpVerdict* verdict);
 void np_filter_batch_avx2(Kind kind, const NpBatch& b, NpVerdict* verdict);
 void fast_path_misses_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
 void fast_path_misses_avx2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
+void np_filter_batch_avx512(Kind kind, const NpBatch& b, NpVerdict* verdict);
+void fast_path_misses_avx512(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
 #endif
 
 namespace {
@@ -75,13 +77,20 @@ bool has_avx2() {
   static const bool yes = __builtin_cpu_supports("avx2") != 0;
   return yes;
 }
+bool has_avx512() {
+  static const bool yes =
+      __builtin_cpu_supports("avx512f") != 0 && __builtin_cpu_supports("fma") != 0;
+  return yes;
+}
 #endif
 
 }  // namespace
 
 void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict) {
 #if CLOTHCD_NP_BATCH_X86
-  if (has_avx2()) {
+  if (has_avx512()) {
+    np_filter_batch_avx512(kind, b, verdict);
+  } else if (has_avx2()) {
     np_filter_batch_avx2(kind, b, verdict);
   } else {
     np_filter_batch_sse2(kind, b, verdict);
@@ -93,7 +102,9 @@ void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict) {
 
 void fast_path_misses(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
 #if CLOTHCD_NP_BATCH_X86
-  if (has_avx2()) {
+  if (has_avx512()) {
+    fast_path_misses_avx512(kind, b, verdict, miss);
+  } else if (has_avx2()) {
     fast_path_misses_avx2(kind, b, verdict, miss);
   } else {
     fast_path_misses_sse2(kind, b, verdict, miss);
@@ -117,6 +128,10 @@ bool fast_path_misses_with(int isa, Kind kind, const NpBatch& b, const NpVerdict
       if (!has_avx2()) return false;
       fast_path_misses_avx2(kind, b, verdict, miss);
       return true;
+    case 3:
+      if (!has_avx512()) return false;
+      fast_path_misses_avx512(kind, b, verdict, miss);
+      return true;
 #endif
     default:
       return false;
@@ -135,6 +150,10 @@ bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdi
     case 2:
       if (!has_avx2()) return false;
       np_filter_batch_avx2(kind, b, verdict);
+      return true;
+    case 3:
+      if (!has_avx512()) return false;
+      np_filter_batch_avx512(kind, b, verdict);
       return true;
 #endif
     default:

@@ -31,11 +31,12 @@ struct NpBatch {
 };
 
 /// verdict[i] = unscaled_np_filter of query i of `b`, for i < b.size. Uses the widest vector
-/// instructions the processor has (AVX2 or the SSE2 baseline).
+/// instructions the processor has (AVX-512, AVX2 or the SSE2 baseline).
 void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict);
 
 /// The same with a fixed instruction set, for tests: 0 scalar (unscaled_np_filter per query),
-/// 1 SSE2, 2 AVX2. Returns false (and does nothing) when the processor lacks it.
+/// 1 SSE2, 2 AVX2, 3 AVX-512F. Returns false (and does nothing) when the processor
+/// lacks it.
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict);
 
 /// The depth (ranges of 2^-kMissLevel of the step) to which fast_path_misses follows the search.
@@ -53,7 +54,8 @@ inline constexpr int kMissLevel = 4;
 void fast_path_misses(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
 
 /// The same with a fixed instruction set, for tests: 0 scalar (the kernel's functions per
-/// query), 1 SSE2, 2 AVX2. Returns false (and does nothing) when the processor lacks it.
+/// query), 1 SSE2, 2 AVX2, 3 AVX-512. Returns false (and does nothing) when the processor lacks
+/// it.
 bool fast_path_misses_with(int isa, Kind kind, const NpBatch& b, const NpVerdict* verdict,
                            bool* miss);
 

@@ -1,4 +1,4 @@
-// The batched NP filter (SSE2, AVX2 and the dispatching entry) against the scalar filter,
+// The batched NP filter (SSE2, AVX2, AVX-512 and the dispatching entry) against the scalar filter,
 // unscaled_np_filter: the same verdict for every query, on seeded random queries over many scales,
 // near-coplanar and exactly coplanar ones, out-of-range magnitudes and non-finite coordinates;
 // and no culled query that the exact oracle finds in contact. Likewise fast_path_misses against
@@ -104,9 +104,9 @@ std::vector<NpVerdict> check_batch(Kind kind, const std::vector<Points>& qs) {
   fill(b, qs);
   std::vector<NpVerdict> expect(qs.size()), got(NpBatch::kCapacity);
   EXPECT_TRUE(ccd_detail::np_filter_batch_with(0, kind, b, expect.data()));
-  for (int isa = 1; isa <= 3; ++isa) {
+  for (int isa = 1; isa <= 4; ++isa) {
     got.assign(got.size(), NpVerdict::Undecided);
-    if (isa < 3) {
+    if (isa < 4) {
       if (!ccd_detail::np_filter_batch_with(isa, kind, b, got.data())) continue;
     } else {
       ccd_detail::np_filter_batch(kind, b, got.data());
@@ -181,9 +181,9 @@ std::vector<bool> check_misses(Kind kind, const std::vector<Points>& qs, int& ke
   EXPECT_TRUE(ccd_detail::np_filter_batch_with(0, kind, b, verdict.data()));
   bool expect[NpBatch::kCapacity], got[NpBatch::kCapacity];
   EXPECT_TRUE(ccd_detail::fast_path_misses_with(0, kind, b, verdict.data(), expect));
-  for (int isa = 1; isa <= 3; ++isa) {
+  for (int isa = 1; isa <= 4; ++isa) {
     std::fill(std::begin(got), std::end(got), false);
-    if (isa < 3) {
+    if (isa < 4) {
       if (!ccd_detail::fast_path_misses_with(isa, kind, b, verdict.data(), got)) continue;
     } else {
       ccd_detail::fast_path_misses(kind, b, verdict.data(), got);

@@ -73,7 +73,7 @@ void compare_verdicts(ccd_detail::Kind kind, const std::vector<std::pair<int, in
     for (std::size_t i = start; i < end; ++i)
       b.push(points_of(pairs[i]));
     ASSERT_TRUE(ccd_detail::np_filter_batch_with(0, kind, b, expect.data()));
-    for (int isa = 1; isa <= 2; ++isa) {
+    for (int isa = 1; isa <= 3; ++isa) {
       if (!ccd_detail::np_filter_batch_with(isa, kind, b, got.data())) continue;
       for (int i = 0; i < b.size; ++i)
         ASSERT_EQ(got[i], expect[i]) << "isa " << isa << " pair " << start + i;
@@ -130,7 +130,7 @@ std::size_t compare_misses(ccd_detail::Kind kind, const std::vector<std::pair<in
       b.push(points_of(pairs[i]));
     ccd_detail::np_filter_batch(kind, b, verdict.data());
     EXPECT_TRUE(ccd_detail::fast_path_misses_with(0, kind, b, verdict.data(), expect));
-    for (int isa = 1; isa <= 2; ++isa) {
+    for (int isa = 1; isa <= 3; ++isa) {
       if (!ccd_detail::fast_path_misses_with(isa, kind, b, verdict.data(), got)) continue;
       for (int i = 0; i < b.size; ++i)
         EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " pair " << start + i;
