@@ -23,6 +23,7 @@
 #include "narrow.hpp"
 #include "options.hpp"
 #include "orphans.hpp"
+#include "pair_list.hpp"
 #include "positions.hpp"
 #include "traversal.hpp"
 
@@ -37,10 +38,12 @@ double seconds_since(Clock::time_point t) {
 // Cones are compared against pi/2 with a small margin for the rounding of the merges.
 constexpr double kConeMargin = 1e-9;
 
+// One thread's share of a traversal: its leaf pairs and the adjacent ones it skipped.
 struct PairBuffer {
-  std::vector<std::pair<int, int>> pairs;
+  detail::PairBlocks pairs;
   std::uint64_t adjacent = 0;
 };
+using PairLocals = tbb::enumerable_thread_specific<PairBuffer>;
 
 // detail::share_vertex(a, b) without its branches: the traversal asks it of every overlapping
 // leaf pair, and most share nothing.
@@ -104,6 +107,8 @@ struct SelfDetector::Impl {
   std::vector<std::pair<int, int>> links;
   bool links_current = false;
   detail::Ownership owner;
+  // The traversal's pair blocks, kept from call to call (pair_list.hpp).
+  PairLocals pair_locals;
   // The triangle pairs of the last unrestricted detect() with boxes widened to
   // opt.reuse_distance that are at most that far apart at t1 (the others' features are farther,
   // wherever their vertices still are), and its positions at t1: a proximity query at most that
@@ -209,8 +214,9 @@ struct SelfDetector::Impl {
     return ok;
   }
 
-  // Overlapping non-adjacent leaf pairs of the culled self traversal.
-  std::vector<std::pair<int, int>> traverse(Rule mode, DetectStats& st) {
+  // Overlapping non-adjacent leaf pairs of the culled self traversal, held in `locals` (emptied
+  // first) until the next traversal into them.
+  detail::PairList traverse(Rule mode, DetectStats& st, PairLocals& locals) {
     const auto& nodes = bvh.nodes();
     const auto& prims = bvh.prim_ids();
     auto cull = [&](int i, detail::TraversalCounters& c) { return culls(mode, i, c); };
@@ -222,13 +228,16 @@ struct SelfDetector::Impl {
         ++out.adjacent;
         return;
       }
-      out.pairs.emplace_back(fa, fb);
+      out.pairs.push(fa, fb);
     };
     std::span<const std::uint8_t> act;
     if (restricted) act = node_active;
     auto tr = detail::make_traversal(nodes, nodes, act, act, cull, leaf);
-    tbb::enumerable_thread_specific<PairBuffer> locals;
-    std::vector<std::pair<int, int>> pairs;
+    for (PairBuffer& l : locals) {
+      l.pairs.clear();
+      l.adjacent = 0;
+    }
+    detail::PairList pairs;
     if (nodes.empty()) return pairs;
     const detail::TraversalCounters c = detail::run_parallel(tr, {0, 0, true}, locals);
     st.box_tests = c.box_tests;
@@ -236,12 +245,8 @@ struct SelfDetector::Impl {
     st.cone_tests = c.cone_tests;
     st.contour_tests = c.contour_tests;
     st.contour_fails = c.contour_fails;
-    std::size_t total = 0;
-    for (const auto& l : locals)
-      total += l.pairs.size();
-    pairs.reserve(total);
     for (const auto& l : locals) {
-      pairs.insert(pairs.end(), l.pairs.begin(), l.pairs.end());
+      pairs.add(l.pairs);
       st.adjacent_pairs += l.adjacent;
     }
     return pairs;
@@ -255,8 +260,8 @@ struct SelfDetector::Impl {
 
   // The feature pairs of `pairs` and of the orphans that collide (ctx's boxes are up to date).
   // With `near`, also flags the pairs whose faces are at most opt.reuse_distance apart at t1.
-  void narrow(const detail::FeatureContext& ctx, const std::vector<std::pair<int, int>>& pairs,
-              DetectResult& res, std::vector<std::uint8_t>* near = nullptr) {
+  void narrow(const detail::FeatureContext& ctx, const detail::PairList& pairs, DetectResult& res,
+              std::vector<std::uint8_t>* near = nullptr) {
     NarrowLocals locals;
     narrow_pairs(ctx, pairs, locals, near);
     narrow_orphans(ctx, locals);
@@ -266,7 +271,7 @@ struct SelfDetector::Impl {
   }
 
   // The feature pairs of the triangle pairs `pairs` that collide, into `locals`.
-  void narrow_pairs(const detail::FeatureContext& ctx, std::span<const std::pair<int, int>> pairs,
+  void narrow_pairs(const detail::FeatureContext& ctx, const detail::PairList& pairs,
                     NarrowLocals& locals, std::vector<std::uint8_t>* near = nullptr) const {
     const bool wide = box_reach() > opt.thickness;
     if (near != nullptr) near->assign(pairs.size(), 0);
@@ -278,44 +283,51 @@ struct SelfDetector::Impl {
       ctx.queue_ee(a, b, ea, eb, out.batch, out.c, out.ee);
     };
     // The pair loop waits on memory: a triangle pair's records and box blocks sit at scattered
-    // places. Fetch them kFar pairs ahead (a record is one cache line, a block three).
-    constexpr std::size_t kFar = 16;
+    // places. Fetch them kFar pairs ahead (a record is one cache line, a block three), within
+    // a piece of the list.
+    constexpr std::size_t kFar = 16, kPiece = 1024;
     const auto fetch_face = [&](int f) {
       detail::prefetch(&owner.record(f));
       const auto* block = reinterpret_cast<const char*>(&ctx.face_boxes[f]);
       for (int line = 0; line < 3; ++line)
         detail::prefetch(block + 64 * line);
     };
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          NarrowBuffer& out = locals.local();
-          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            if (i + kFar < pairs.size()) {
-              fetch_face(pairs[i + kFar].first);
-              fetch_face(pairs[i + kFar].second);
-            }
-            const auto [f, g] = pairs[i];
-            // Widened leaf boxes: no feature pair of faces whose own boxes miss.
-            if (wide && !detail::overlap(ctx.face_boxes[f].face(), ctx.face_boxes[g].face())) {
-              if (near != nullptr) {
-                (*near)[i] = !(detail::triangle_triangle_bound(detail::corners(v1, faces[f]),
-                                                               detail::corners(v1, faces[g])) >
-                               opt.reuse_distance);
-              }
-              continue;
-            }
-            ++out.c.triangle_pairs;
-            double d1 = 0.0;
-            const bool apart = ctx.faces_apart(f, g, near != nullptr ? &d1 : nullptr);
-            if (near != nullptr) (*near)[i] = !(d1 > opt.reuse_distance);
-            if (apart) {
-              ++out.c.faces_apart;
-              continue;
-            }
-            triangle_pair(ctx, f, g, out, kvf, kee);
-          }
-        });
+    // Pair i of the list, faces f and g.
+    const auto one = [&](std::size_t i, int f, int g, NarrowBuffer& out) {
+      // Widened leaf boxes: no feature pair of faces whose own boxes miss.
+      if (wide && !detail::overlap(ctx.face_boxes[f].face(), ctx.face_boxes[g].face())) {
+        if (near != nullptr) {
+          (*near)[i] = !(detail::triangle_triangle_bound(detail::corners(v1, faces[f]),
+                                                         detail::corners(v1, faces[g])) >
+                         opt.reuse_distance);
+        }
+        return;
+      }
+      ++out.c.triangle_pairs;
+      double d1 = 0.0;
+      const bool apart = ctx.faces_apart(f, g, near != nullptr ? &d1 : nullptr);
+      if (near != nullptr) (*near)[i] = !(d1 > opt.reuse_distance);
+      if (apart) {
+        ++out.c.faces_apart;
+        return;
+      }
+      triangle_pair(ctx, f, g, out, kvf, kee);
+    };
+    const std::vector<detail::PairList::Piece> pieces = pairs.pieces(kPiece);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces.size(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        NarrowBuffer& out = locals.local();
+                        for (std::size_t p = r.begin(); p != r.end(); ++p) {
+                          const std::span<const detail::FacePair> piece = pieces[p].pairs;
+                          for (std::size_t k = 0; k < piece.size(); ++k) {
+                            if (k + kFar < piece.size()) {
+                              fetch_face(piece[k + kFar].first);
+                              fetch_face(piece[k + kFar].second);
+                            }
+                            one(pieces[p].first + k, piece[k].first, piece[k].second, out);
+                          }
+                        }
+                      });
     for (auto& l : locals)  // at most one partial batch of each kind per thread
       ctx.flush(l.batch, l.c, l.vf, l.ee);
   }
@@ -527,7 +539,7 @@ struct SelfDetector::Impl {
     }
     const std::size_t ng = sets.size();
     struct GroupPairs {
-      std::vector<std::pair<int, int>> pairs;
+      detail::PairBlocks pairs;
       std::uint64_t adjacent = 0, box_tests = 0;
     };
     struct Local {
@@ -543,7 +555,7 @@ struct SelfDetector::Impl {
         ++gp.adjacent;
         return;
       }
-      gp.pairs.emplace_back(fa, fb);
+      gp.pairs.push(fa, fb);
     };
     auto tr = detail::make_traversal(nodes, nodes, {}, {}, no_cull, leaf);
     tbb::enumerable_thread_specific<Local> locals([ng] {
@@ -601,8 +613,9 @@ struct SelfDetector::Impl {
         GroupPairs& gp = l.groups[g];
         found[g].stats.box_tests += gp.box_tests;
         found[g].stats.adjacent_pairs += gp.adjacent;
-        narrow_pairs(ctx, gp.pairs, narrow_locals);
-        std::vector<std::pair<int, int>>().swap(gp.pairs);
+        detail::PairList list;
+        list.add(gp.pairs);
+        narrow_pairs(ctx, list, narrow_locals);
       }
       gather(narrow_locals, found[g]);
     }
@@ -632,7 +645,7 @@ struct SelfDetector::Impl {
     DetectStats& st = res.stats;
     refit(st);
     auto t = Clock::now();
-    auto pairs = traverse(rule(), st);
+    const detail::PairList pairs = traverse(rule(), st, pair_locals);
     st.time_traverse = seconds_since(t);
     t = Clock::now();
     detail::FeatureContext ctx = ccd_context();
@@ -644,15 +657,16 @@ struct SelfDetector::Impl {
     if (keep) {
       reuse.x1 = v1;
       reuse.pairs.clear();
-      for (std::size_t i = 0; i < pairs.size(); ++i) {
-        if (near[i] != 0) reuse.pairs.push_back(pairs[i]);
-      }
+      pairs.for_each([&](std::size_t i, const detail::FacePair& p) {
+        if (near[i] != 0) reuse.pairs.push_back(p);
+      });
       reuse.valid = true;
     }
 
     if (opt.research.verify && rule() != Rule::None) {
       DetectResult ref;
-      const auto all = traverse(Rule::None, ref.stats);
+      PairLocals all_locals;  // `pairs` is still in use
+      const detail::PairList all = traverse(Rule::None, ref.stats, all_locals);
       narrow(ctx, all, ref);
       research::Verification& ver = res.verification;
       ver.ran = true;
@@ -690,20 +704,22 @@ struct SelfDetector::Impl {
       const double d = edge_edge_distance_if_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
       if (d <= h) out.ee.push_back({a, b, d});
     };
-    auto test_pairs = [&](const std::vector<std::pair<int, int>>& pairs) {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+    auto test_pairs = [&](const detail::PairList& pairs) {
+      const std::vector<detail::PairList::Piece> pieces = pairs.pieces(64);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces.size(), 1),
                         [&](const tbb::blocked_range<std::size_t>& r) {
                           Buffer& out = locals.local();
-                          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                            const auto [f, g] = pairs[i];
-                            if (!detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) continue;
-                            // No feature pair is closer than the whole triangles' bound.
-                            const Face &a = topo.faces()[f], &b = topo.faces()[g];
-                            if (detail::triangle_triangle_bound(detail::corners(v0, a),
-                                                                detail::corners(v0, b)) > h) {
-                              continue;
+                          for (std::size_t p = r.begin(); p != r.end(); ++p) {
+                            for (const auto& [f, g] : pieces[p].pairs) {
+                              if (!detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) continue;
+                              // No feature pair is closer than the whole triangles' bound.
+                              const Face &a = topo.faces()[f], &b = topo.faces()[g];
+                              if (detail::triangle_triangle_bound(detail::corners(v0, a),
+                                                                  detail::corners(v0, b)) > h) {
+                                continue;
+                              }
+                              triangle_pair(ctx, f, g, out, kvf, kee);
                             }
-                            triangle_pair(ctx, f, g, out, kvf, kee);
                           }
                         });
     };
@@ -718,12 +734,12 @@ struct SelfDetector::Impl {
         ~Unrestrict() { im.restricted = im.outside = false; }
       } unrestrict{*this};
       outside = true;
-      test_pairs(reuse.pairs);
+      test_pairs(detail::PairList(reuse.pairs));
       reused = reuse.pairs.size();
       outside = false;
-      test_pairs(traverse(Rule::None, st));
+      test_pairs(traverse(Rule::None, st, pair_locals));
     } else {
-      test_pairs(traverse(Rule::None, st));
+      test_pairs(traverse(Rule::None, st, pair_locals));
     }
     Buffer& out = locals.local();
     for (const auto& [v, f] : orphans.vf) {

@@ -773,7 +773,8 @@ inline FeatureOverlaps feature_overlaps_scalar(const FaceBoxes& a, const FaceBox
 struct StepFaceBoxes {
   const FeatureContext& ctx;
   template <class Record>
-  [[nodiscard]] FeatureOverlaps overlaps(const Record&, const Record&, int f, int g) const {
+  [[nodiscard, gnu::always_inline]] FeatureOverlaps overlaps(const Record&, const Record&, int f,
+                                                             int g) const {
     return feature_overlaps(ctx.face_boxes[f], ctx.face_boxes[g]);
   }
 };

@@ -1,0 +1,115 @@
+#pragma once
+// The triangle pairs the traversal hands to the narrow phase, stored per thread in blocks.
+//
+// Why blocks: one step of a large mesh finds millions of pairs (cloth_ball: 3.9 M, 31 MB). A
+// growing vector copies them at every doubling and touches about twice that memory, and merging
+// the threads' vectors into one copies them again. Fresh memory is dear (each page is faulted in
+// and zeroed), so the blocks are never moved, the narrow phase reads them where they are, and a
+// detector keeps them for its next call.
+
+#include <algorithm>
+#include <cstddef>
+#include <span>
+#include <utility>
+#include <vector>
+
+namespace clothcd::detail {
+
+using FacePair = std::pair<int, int>;
+
+/// One thread's pairs: blocks of growing capacity (4 Ki pairs, doubling up to 512 Ki, 4 MiB),
+/// filled in order. clear() empties them and keeps their memory.
+class PairBlocks {
+ public:
+  void push(int a, int b) {
+    if (cur_ == nullptr || cur_->size() == cur_->capacity()) next_block();
+    cur_->emplace_back(a, b);
+  }
+  void clear() {
+    for (std::size_t i = 0; i < used_; ++i)
+      blocks_[i].clear();
+    used_ = 0;
+    cur_ = nullptr;
+  }
+  [[nodiscard]] std::size_t size() const {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < used_; ++i)
+      n += blocks_[i].size();
+    return n;
+  }
+  /// Appends a view of each non-empty block to `out`, in the order the pairs were pushed.
+  void views(std::vector<std::span<const FacePair>>& out) const {
+    for (std::size_t i = 0; i < used_; ++i) {
+      if (!blocks_[i].empty()) out.emplace_back(blocks_[i]);
+    }
+  }
+
+ private:
+  static constexpr std::size_t kFirst = std::size_t{1} << 12, kLargest = std::size_t{1} << 19;
+
+  void next_block() {
+    if (used_ == blocks_.size()) {
+      blocks_.emplace_back();
+      blocks_.back().reserve(std::min(kFirst << std::min<std::size_t>(used_, 7), kLargest));
+    }
+    cur_ = &blocks_[used_++];
+  }
+
+  std::vector<std::vector<FacePair>> blocks_;  // only the first used_ hold this call's pairs
+  std::size_t used_ = 0;
+  std::vector<FacePair>* cur_ = nullptr;  // blocks_[used_ - 1], or none yet
+};
+
+/// A step's pairs as views of the blocks that hold them (or of any contiguous pair lists).
+class PairList {
+ public:
+  PairList() = default;
+  explicit PairList(std::span<const FacePair> pairs) { add(pairs); }
+
+  void add(std::span<const FacePair> pairs) {
+    if (pairs.empty()) return;
+    parts_.push_back(pairs);
+    size_ += pairs.size();
+  }
+  void add(const PairBlocks& b) {
+    const std::size_t first = parts_.size();
+    b.views(parts_);
+    for (std::size_t i = first; i < parts_.size(); ++i)
+      size_ += parts_[i].size();
+  }
+  [[nodiscard]] std::size_t size() const { return size_; }
+  [[nodiscard]] bool empty() const { return size_ == 0; }
+
+  /// The pairs in pieces of at most `piece` (the last of each view may be shorter), each with
+  /// the index of its first pair in the list's order: work items for a parallel loop.
+  struct Piece {
+    std::span<const FacePair> pairs;
+    std::size_t first = 0;
+  };
+  [[nodiscard]] std::vector<Piece> pieces(std::size_t piece) const {
+    std::vector<Piece> out;
+    std::size_t first = 0;
+    for (const auto& p : parts_) {
+      for (std::size_t i = 0; i < p.size(); i += piece) {
+        out.push_back({p.subspan(i, std::min(piece, p.size() - i)), first + i});
+      }
+      first += p.size();
+    }
+    return out;
+  }
+  /// Calls f(index, pair) for every pair, in the list's order.
+  template <class F>
+  void for_each(F&& f) const {
+    std::size_t i = 0;
+    for (const auto& p : parts_) {
+      for (const FacePair& q : p)
+        f(i++, q);
+    }
+  }
+
+ private:
+  std::vector<std::span<const FacePair>> parts_;
+  std::size_t size_ = 0;
+};
+
+}  // namespace clothcd::detail
