@@ -12,39 +12,55 @@ namespace clothcd::detail {
 
 namespace {
 
-// The orphans found at vertex v (each vertex-sharing face pair is visited at its smallest shared
-// vertex), appended unsorted and possibly repeated.
-void orphans_at(const Topology& topo, int v, Orphans& o) {
+// One thread's finds, and a stamp per face and per edge: the feature whose candidates are being
+// examined, so that each candidate is examined once per feature.
+struct Scratch {
+  Orphans found;
+  std::vector<int> face_seen, edge_seen;
+};
+
+// VF orphans of vertex p: the faces g without p that touch every face of p (then no face of p
+// can represent (p, g)). Such a g touches p's first face at one of its two other corners, so the
+// faces at those corners are the only candidates. A vertex on no face has no VF pair to test.
+void vf_orphans_of(const Topology& topo, int p, Scratch& s) {
   const auto& faces = topo.faces();
-  const auto vf = topo.vertex_faces(v);
-  for (std::size_t i = 0; i < vf.size(); ++i) {
-    for (std::size_t j = i + 1; j < vf.size(); ++j) {
-      const int f = vf[i], g = vf[j];
-      const Face &tf = faces[f], &tg = faces[g];
-      // Visit each vertex-sharing pair once: at its smallest shared vertex.
-      int smallest = -1;
-      for (int x : tf) {
-        if ((x == tg[0] || x == tg[1] || x == tg[2]) && (smallest < 0 || x < smallest)) {
-          smallest = x;
-        }
-      }
-      if (smallest != v) continue;
-      auto vf_candidate = [&](int p, int face) {
-        const Face& t = faces[face];
-        if (p == t[0] || p == t[1] || p == t[2]) return;
-        if (vf_representative(topo, p, face) < 0) o.vf.emplace_back(p, face);
-      };
-      for (int p : tf)
-        vf_candidate(p, g);
-      for (int p : tg)
-        vf_candidate(p, f);
-      for (int ea : topo.face_edges(f)) {
-        for (int eb : topo.face_edges(g)) {
-          const Edge &a = topo.edges()[ea], &b = topo.edges()[eb];
-          if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
-          const int e1 = std::min(ea, eb), e2 = std::max(ea, eb);
-          if (ee_representative(topo, e1, e2).first < 0) o.ee.emplace_back(e1, e2);
-        }
+  const auto star = topo.vertex_faces(p);
+  if (star.empty()) return;
+  for (int x : faces[star[0]]) {
+    if (x == p) continue;
+    for (int g : topo.vertex_faces(x)) {
+      if (s.face_seen[g] == p) continue;
+      s.face_seen[g] = p;
+      const Face& tg = faces[g];
+      if (has_corner(tg, p)) continue;
+      const bool orphan =
+          std::all_of(star.begin(), star.end(), [&](int h) { return share_vertex(faces[h], tg); });
+      if (orphan) s.found.vf.emplace_back(p, g);
+    }
+  }
+}
+
+// EE orphans (ea, eb) with ea < eb: edges sharing no vertex such that every face of ea touches
+// every face of eb. Then eb's first face touches ea's first face h, at a corner of h, so eb is an
+// edge of a face at one of h's corners: the only candidates.
+void ee_orphans_of(const Topology& topo, int ea, Scratch& s) {
+  const auto& faces = topo.faces();
+  const auto& edges = topo.edges();
+  const auto fa = topo.edge_faces(ea);
+  const Edge& a = edges[ea];
+  for (int x : faces[fa[0]]) {
+    for (int g : topo.vertex_faces(x)) {
+      for (int eb : topo.face_edges(g)) {
+        if (eb <= ea || s.edge_seen[eb] == ea) continue;
+        s.edge_seen[eb] = ea;
+        const Edge& b = edges[eb];
+        if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) continue;
+        const auto fb = topo.edge_faces(eb);
+        const bool orphan = std::all_of(fa.begin(), fa.end(), [&](int f) {
+          return std::all_of(fb.begin(), fb.end(),
+                             [&](int h) { return share_vertex(faces[f], faces[h]); });
+        });
+        if (orphan) s.found.ee.emplace_back(ea, eb);
       }
     }
   }
@@ -53,23 +69,32 @@ void orphans_at(const Topology& topo, int v, Orphans& o) {
 }  // namespace
 
 Orphans find_orphans(const Topology& topo) {
-  // Vertices are independent: per-thread lists, merged, then sorted and made unique as before.
-  tbb::enumerable_thread_specific<Orphans> locals;
+  // Features are independent: per-thread lists, merged and sorted.
+  tbb::enumerable_thread_specific<Scratch> locals([&] {
+    Scratch s;
+    s.face_seen.assign(topo.num_faces(), -1);
+    s.edge_seen.assign(topo.num_edges(), -1);
+    return s;
+  });
   tbb::parallel_for(tbb::blocked_range<int>(0, topo.num_vertices(), 1024),
                     [&](const tbb::blocked_range<int>& r) {
-                      Orphans& l = locals.local();
+                      Scratch& s = locals.local();
                       for (int v = r.begin(); v != r.end(); ++v)
-                        orphans_at(topo, v, l);
+                        vf_orphans_of(topo, v, s);
+                    });
+  tbb::parallel_for(tbb::blocked_range<int>(0, topo.num_edges(), 1024),
+                    [&](const tbb::blocked_range<int>& r) {
+                      Scratch& s = locals.local();
+                      for (int e = r.begin(); e != r.end(); ++e)
+                        ee_orphans_of(topo, e, s);
                     });
   Orphans o;
-  for (const Orphans& l : locals) {
-    o.vf.insert(o.vf.end(), l.vf.begin(), l.vf.end());
-    o.ee.insert(o.ee.end(), l.ee.begin(), l.ee.end());
+  for (const Scratch& l : locals) {
+    o.vf.insert(o.vf.end(), l.found.vf.begin(), l.found.vf.end());
+    o.ee.insert(o.ee.end(), l.found.ee.begin(), l.found.ee.end());
   }
   std::sort(o.vf.begin(), o.vf.end());
-  o.vf.erase(std::unique(o.vf.begin(), o.vf.end()), o.vf.end());
   std::sort(o.ee.begin(), o.ee.end());
-  o.ee.erase(std::unique(o.ee.begin(), o.ee.end()), o.ee.end());
   return o;
 }
 
