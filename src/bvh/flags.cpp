@@ -2,6 +2,7 @@
 // and the disk test with its oriented boundary loop (the contour test, docs/algorithms.md 1.5).
 
 #include <algorithm>
+#include <numeric>
 
 #include "clothcd/bvh/bvh.hpp"
 #include "core/checked_index.hpp"
@@ -43,47 +44,60 @@ void Bvh::compute_flags(const Topology& topo) {
   for (int i = 0; i < static_cast<int>(prim_ids_.size()); ++i)
     pos[prim_ids_[i]] = i;
 
-  // Connectedness: both children connected and some edge joins them is enough; otherwise (a
-  // spatial split may cut a connected set into disconnected halves) search the node's face graph.
-  std::vector<int> seen(topo.num_faces(), -1), queue;
-  auto in_node = [&](const BvhNode& n, int g) {
-    return pos[g] >= n.first && pos[g] < n.first + n.count;
+  // Connectedness from the edge adjacencies: faces f and g sharing an edge part at one node, the
+  // lowest holding both, where their leaf positions fall on different sides. Counting the
+  // components bottom-up (a node has its children's, less the merges its own adjacencies make in
+  // a union-find over the faces) gives every node's at once. Nodes are numbered after their
+  // ancestors, so a backward sweep has merged a node's descendants, and only those among its
+  // faces, when it reaches the node.
+  struct Join {
+    int node, f, g;
+  };
+  std::vector<Join> joins;
+  joins.reserve(topo.num_edges());
+  for (int e = 0; e < topo.num_edges(); ++e) {
+    const auto ef = topo.edge_faces(e);
+    for (std::size_t x = 0; x < ef.size(); ++x) {
+      for (std::size_t y = x + 1; y < ef.size(); ++y) {
+        const int p = pos[ef[x]], q = pos[ef[y]];
+        int i = 0;
+        for (;;) {
+          const BvhNode& l = nodes_[nodes_[i].left];
+          const bool pl = p < l.first + l.count, ql = q < l.first + l.count;
+          if (pl != ql) break;
+          i = pl ? nodes_[i].left : nodes_[i].left + 1;
+        }
+        joins.push_back({i, ef[x], ef[y]});
+      }
+    }
+  }
+  std::sort(joins.begin(), joins.end(),
+            [](const Join& x, const Join& y) { return x.node > y.node; });
+  std::size_t next_join = 0;
+  std::vector<int> parent(topo.num_faces()), comps(nn, 0);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&](int f) {
+    while (parent[f] != f) {
+      parent[f] = parent[parent[f]];
+      f = parent[f];
+    }
+    return f;
   };
   for (int i = nn - 1; i >= 0; --i) {
     BvhNode& n = nodes_[i];
     if (n.is_leaf()) {
       n.flags = BvhNode::kConnected | BvhNode::kDisk;
+      comps[i] = 1;
       continue;
     }
-    const BvhNode& l = nodes_[n.left];
-    const BvhNode& r = nodes_[n.left + 1];
-    n.flags = 0;
-    bool connected = false;
-    if (l.connected() && r.connected()) {
-      const BvhNode& small = l.count <= r.count ? l : r;
-      const BvhNode& large = l.count <= r.count ? r : l;
-      for (int p = small.first; p < small.first + small.count && !connected; ++p) {
-        for (int e : topo.face_edges(prim_ids_[p])) {
-          for (int g : topo.edge_faces(e))
-            connected = connected || in_node(large, g);
-        }
-      }
-    } else {
-      queue.assign(1, prim_ids_[n.first]);
-      seen[queue[0]] = i;
-      for (std::size_t k = 0; k < queue.size(); ++k) {
-        for (int e : topo.face_edges(queue[k])) {
-          for (int g : topo.edge_faces(e)) {
-            if (seen[g] != i && in_node(n, g)) {
-              seen[g] = i;
-              queue.push_back(g);
-            }
-          }
-        }
-      }
-      connected = static_cast<int>(queue.size()) == n.count;
+    comps[i] = comps[n.left] + comps[n.left + 1];
+    for (; next_join < joins.size() && joins[next_join].node == i; ++next_join) {
+      const int a = root(joins[next_join].f), b = root(joins[next_join].g);
+      if (a == b) continue;
+      parent[a] = b;
+      --comps[i];
     }
-    if (connected) n.flags = BvhNode::kConnected;
+    n.flags = comps[i] == 1 ? BvhNode::kConnected : 0;
   }
 
   // Disk test of connected internal nodes with stamped scratch arrays (no hashing).

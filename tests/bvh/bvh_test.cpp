@@ -11,6 +11,7 @@
 
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/detect/procedural.hpp"
+#include "support/random_gen.hpp"
 
 namespace clothcd {
 namespace {
@@ -89,6 +90,41 @@ TEST(Bvh, StructureAndFlagsMatchBruteForce) {
       }
     }
   }
+}
+
+// The connectivity flag on random meshes: boundaries, edges of three or more faces, duplicate
+// faces, several components, faces scattered in space so that splits cut them apart.
+TEST(Bvh, ConnectedFlagMatchesBruteForceOnRandomMeshes) {
+  int connected = 0, disconnected = 0;
+  for (std::uint64_t seed = 1; seed <= 80; ++seed) {
+    test::Gen gen(seed);
+    const int nv = gen.integer(6, 40);
+    const int nf = gen.integer(2, 70);
+    std::vector<Face> faces;
+    for (int i = 0; i < nf; ++i) {
+      const Face t = gen.face(nv);
+      faces.push_back(t);
+      if (gen.integer(0, 9) == 0) faces.push_back({t[2], t[0], t[1]});
+    }
+    const Topology topo(faces, nv);
+    std::vector<Eigen::Vector3d> v(nv);
+    for (auto& x : v)
+      x = gen.vec(1.0);
+    for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+      SCOPED_TRACE(::testing::Message() << "seed " << seed << " build " << int(build));
+      const Bvh bvh(topo, v, build);
+      for (int i = 0; i < static_cast<int>(bvh.nodes().size()); ++i) {
+        const BvhNode& n = bvh.nodes()[i];
+        const std::vector<int> in(bvh.prim_ids().begin() + n.first,
+                                  bvh.prim_ids().begin() + n.first + n.count);
+        const bool want = connected_brute(topo, in);
+        EXPECT_EQ(n.connected(), want) << "node " << i;
+        (want ? connected : disconnected) += n.is_leaf() ? 0 : 1;
+      }
+    }
+  }
+  EXPECT_GT(connected, 500);
+  EXPECT_GT(disconnected, 500);
 }
 
 // refit_changed, and refit_moved with the moved vertices flagged, over a sequence of calls (a few
