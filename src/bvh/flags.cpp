@@ -1,8 +1,13 @@
 // Per-node topology flags computed once at build: edge-connectedness (the gate of cone culling)
 // and the disk test with its oriented boundary loop (the contour test, docs/algorithms.md 1.5).
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <numeric>
+#include <span>
 
 #include "clothcd/bvh/bvh.hpp"
 #include "core/checked_index.hpp"
@@ -37,6 +42,75 @@ std::vector<std::uint8_t> Bvh::nodes_holding(std::span<const std::uint8_t> face_
   }
   return out;
 }
+
+namespace {
+
+// Stamped scratch arrays of the disk test (no hashing): vertex and edge entries stamped with the
+// node being tested, and the boundary loops found so far.
+struct DiskScratch {
+  std::vector<int> vstamp, outstamp, next, estamp, ecount, efrom, loops;
+  explicit DiskScratch(const Topology& topo)
+      : vstamp(topo.num_vertices(), -1),
+        outstamp(topo.num_vertices(), -1),
+        next(topo.num_vertices(), -1),
+        estamp(topo.num_edges(), -1),
+        ecount(topo.num_edges(), 0),
+        efrom(topo.num_edges(), -1) {}
+};
+
+// Whether the faces of node s (`faces`) form a disk: manifold, consistently oriented, Euler
+// characteristic 1, one boundary loop without pinches. Appends that loop to sc.loops when they
+// do. The stamps in `sc` belong to other nodes (or are -1), never to s.
+bool disk_loop(const Topology& topo, int s, std::span<const int> faces, DiskScratch& sc) {
+  int nv = 0, ne = 0;
+  for (const int f : faces) {
+    const Face& t = topo.faces()[f];
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k];
+      if (sc.vstamp[a] != s) {
+        sc.vstamp[a] = s;
+        ++nv;
+      }
+      const int e = topo.face_edges(f)[k];
+      if (sc.estamp[e] != s) {
+        sc.estamp[e] = s;
+        sc.ecount[e] = 1;
+        sc.efrom[e] = a;
+        ++ne;
+      } else {
+        ++sc.ecount[e];
+        // Manifold and consistently oriented: an inner edge is used twice, in opposite senses.
+        if (sc.ecount[e] > 2 || sc.efrom[e] == a) return false;
+      }
+    }
+  }
+  if (nv - ne + static_cast<int>(faces.size()) != 1) return false;
+  int nb = 0, start = -1;
+  for (const int f : faces) {
+    const Face& t = topo.faces()[f];
+    for (int k = 0; k < 3; ++k) {
+      const int e = topo.face_edges(f)[k];
+      if (sc.ecount[e] != 1) continue;
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (sc.outstamp[a] == s) return false;  // a boundary vertex touched twice: a pinch
+      sc.outstamp[a] = s;
+      sc.next[a] = b;
+      if (start < 0) start = a;
+      ++nb;
+    }
+  }
+  if (nb < 3) return false;
+  const std::size_t first = sc.loops.size();
+  int v = start;
+  do {
+    sc.loops.push_back(v);
+    if (sc.outstamp[v] != s || static_cast<int>(sc.loops.size() - first) > nb) return false;
+    v = sc.next[v];
+  } while (v != start);
+  return static_cast<int>(sc.loops.size() - first) == nb;
+}
+
+}  // namespace
 
 void Bvh::compute_flags(const Topology& topo) {
   const int nn = static_cast<int>(nodes_.size());
@@ -100,75 +174,41 @@ void Bvh::compute_flags(const Topology& topo) {
     n.flags = comps[i] == 1 ? BvhNode::kConnected : 0;
   }
 
-  // Disk test of connected internal nodes with stamped scratch arrays (no hashing).
-  std::vector<int> vstamp(topo.num_vertices(), -1), outstamp(topo.num_vertices(), -1);
-  std::vector<int> next(topo.num_vertices(), -1);
-  std::vector<int> estamp(topo.num_edges(), -1), ecount(topo.num_edges(), 0);
-  std::vector<int> efrom(topo.num_edges(), -1);
+  // Disk test of connected internal nodes, in parallel: each thread has stamped scratch arrays
+  // (no hashing) and keeps the loops it finds; they are then laid out in node order.
+  tbb::enumerable_thread_specific<DiskScratch> scratch([&] { return DiskScratch(topo); });
+  struct Found {
+    const DiskScratch* in = nullptr;  // none: not a disk
+    std::size_t at = 0, size = 0;
+  };
+  std::vector<Found> found(nn);
+  tbb::parallel_for(tbb::blocked_range<int>(0, nn, 256), [&](const tbb::blocked_range<int>& r) {
+    DiskScratch& sc = scratch.local();
+    for (int i = r.begin(); i != r.end(); ++i) {
+      BvhNode& n = nodes_[i];
+      if (n.is_leaf() || !n.connected()) continue;
+      const std::size_t at = sc.loops.size();
+      const std::span<const int> faces(prim_ids_.data() + n.first,
+                                       static_cast<std::size_t>(n.count));
+      if (!disk_loop(topo, i, faces, sc)) {
+        sc.loops.resize(at);
+        continue;
+      }
+      n.flags |= BvhNode::kDisk;
+      found[i] = {&sc, at, sc.loops.size() - at};
+    }
+  });
   contour_offsets_.assign(nn + 1, 0);
   contour_vertices_.clear();
-  std::vector<int> loop;
   for (int i = 0; i < nn; ++i) {
     // The loops of all disk nodes together can outgrow the int offsets long before the face ids
     // do (a node's loop is counted at every level above its faces).
     contour_offsets_[i] = detail::checked_int(contour_vertices_.size(), "BVH contours");
-    BvhNode& n = nodes_[i];
-    if (n.is_leaf() || !n.connected()) continue;
-    const int s = i;
-    int nv = 0, ne = 0;
-    bool ok = true;
-    for (int p = n.first; p < n.first + n.count && ok; ++p) {
-      const int f = prim_ids_[p];
-      const Face& t = topo.faces()[f];
-      for (int k = 0; k < 3; ++k) {
-        const int a = t[k];
-        if (vstamp[a] != s) {
-          vstamp[a] = s;
-          ++nv;
-        }
-        const int e = topo.face_edges(f)[k];
-        if (estamp[e] != s) {
-          estamp[e] = s;
-          ecount[e] = 1;
-          efrom[e] = a;
-          ++ne;
-        } else {
-          ++ecount[e];
-          // Manifold and consistently oriented: an inner edge is used twice, in opposite senses.
-          if (ecount[e] > 2 || efrom[e] == a) ok = false;
-        }
-      }
-    }
-    if (!ok || nv - ne + n.count != 1) continue;
-    int nb = 0, start = -1;
-    for (int p = n.first; p < n.first + n.count && ok; ++p) {
-      const int f = prim_ids_[p];
-      const Face& t = topo.faces()[f];
-      for (int k = 0; k < 3; ++k) {
-        const int e = topo.face_edges(f)[k];
-        if (ecount[e] != 1) continue;
-        const int a = t[k], b = t[(k + 1) % 3];
-        if (outstamp[a] == s) ok = false;  // a boundary vertex touched twice: a pinch
-        outstamp[a] = s;
-        next[a] = b;
-        if (start < 0) start = a;
-        ++nb;
-      }
-    }
-    if (!ok || nb < 3) continue;
-    loop.clear();
-    int v = start;
-    do {
-      loop.push_back(v);
-      if (outstamp[v] != s || static_cast<int>(loop.size()) > nb) {
-        ok = false;
-        break;
-      }
-      v = next[v];
-    } while (v != start);
-    if (!ok || static_cast<int>(loop.size()) != nb) continue;
-    n.flags |= BvhNode::kDisk;
-    contour_vertices_.insert(contour_vertices_.end(), loop.begin(), loop.end());
+    const Found& f = found[i];
+    if (f.in == nullptr) continue;
+    const auto first = f.in->loops.begin() + static_cast<std::ptrdiff_t>(f.at);
+    contour_vertices_.insert(contour_vertices_.end(), first,
+                             first + static_cast<std::ptrdiff_t>(f.size));
   }
   contour_offsets_[nn] = detail::checked_int(contour_vertices_.size(), "BVH contours");
 }
