@@ -3,9 +3,11 @@
 // summary and optionally writes JSON, or a table of every build, culling mode and policy.
 #include <fmt/format.h>
 #include <tbb/global_control.h>
+#include <chrono>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -231,6 +233,10 @@ int run(const Args& a) {
   o.thickness = a.thickness;
   o.cull_min_triangles = a.cull_min_triangles;
   o.research.verify = a.verify;
+  const auto start = std::chrono::steady_clock::now();
+  const auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
   const auto [m0, m1] = load_frames(a);
 
   // Original id of each detector vertex (the smallest original id of a welded cluster).
@@ -266,19 +272,23 @@ int run(const Args& a) {
     print_table(w0, w1, a.thickness, a.table_optimal);
     return 0;
   }
+  const double reading = since(start);
+  const auto built = std::chrono::steady_clock::now();
   SelfDetector det(w0.faces, w0.num_vertices(), vertices_matrix(w0), o);
+  const double setup = since(built);
   const DetectResult r = det.detect(vertices_matrix(w0), vertices_matrix(w1));
   const DetectStats& s = r.stats;
   fmt::print(
       "{} triangles, bvh {} ({:.1f}% edge-connected, {:.1f}% disk internal nodes), policy {}, "
       "culling {}\ntriangle pairs {} ({} culled whole by the distance filter), nodes culled {}, VF "
       "tests {} (NP culled {}), EE tests {} (NP culled {})\ncollisions: {} VF, {} EE\ntime: refit "
-      "{:.4f} s, traversal {:.4f} s, narrow phase {:.4f} s\n",
+      "{:.4f} s, traversal {:.4f} s, narrow phase {:.4f} s\nsetup: reading {:.4f} s, detector "
+      "{:.4f} s (topology, tree, orphans, ownership)\n",
       w0.num_faces(), a.bvh, 100 * s.connected_share(),
       100.0 * s.disk_internal_nodes / std::max(1, s.internal_nodes), a.policy, a.culling,
       s.triangle_pairs, s.triangle_pairs_apart, s.nodes_culled, s.vf_tests, s.vf_np_culled,
       s.ee_tests, s.ee_np_culled, r.vf.size(), r.ee.size(), s.time_refit, s.time_traverse,
-      s.time_narrow);
+      s.time_narrow, reading, setup);
   const research::Verification& ver = r.verification;
   if (ver.ran) {
     fmt::print(

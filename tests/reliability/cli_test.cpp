@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -231,6 +232,19 @@ TEST(CliDetect, ThicknessReportsTrianglePairsCulledWhole) {
       EXPECT_LT(apart, pairs);
     }
   }
+}
+
+TEST(CliDetect, PrintsItsPhasesAndSetupTimes) {
+  // The summary's last lines: the detection's phases, then reading and building the detector,
+  // each a time in seconds.
+  CliScratch dir;
+  write_step(dir);
+  const auto r = dir.run("detect --t0 t0.obj --t1 t1.obj --culling sound");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::regex times(
+      R"(time: refit [0-9.]+ s, traversal [0-9.]+ s, narrow phase [0-9.]+ s\n)"
+      R"(setup: reading [0-9.]+ s, detector [0-9.]+ s \(topology, tree, orphans, ownership\)\n$)");
+  EXPECT_TRUE(std::regex_search(r.out, times)) << r.out;
 }
 
 TEST(CliDetect, CullMinTrianglesSameCollisionsFewerConeTests) {
