@@ -184,6 +184,17 @@ Header parse_header(const std::string& file, std::string_view data) {
   return h;
 }
 
+// Where a value is read, for error messages: formatted only when one is thrown (a mesh has
+// millions of values and no error).
+struct Where {
+  std::string_view element;
+  std::uint64_t item = 0;
+  std::string_view property;
+  [[nodiscard]] std::string str() const {
+    return fmt::format("{} {}, property '{}'", element, item, property);
+  }
+};
+
 // Reads the body values of a binary file with bounds checks.
 class BinarySource {
  public:
@@ -192,7 +203,7 @@ class BinarySource {
         body_(body),
         swap_(big_endian != (std::endian::native == std::endian::big)) {}
 
-  std::int64_t read_int(Scalar s, const std::string& where) {
+  std::int64_t read_int(Scalar s, const Where& where) {
     switch (s) {
       case Scalar::Int8:
         return get<std::int8_t>(where);
@@ -210,16 +221,16 @@ class BinarySource {
       case Scalar::Float64:
         break;
     }
-    throw input_error(file_, 0, fmt::format("{}: expected an integer type", where));
+    throw input_error(file_, 0, fmt::format("{}: expected an integer type", where.str()));
   }
 
-  double read_real(Scalar s, const std::string& where) {
+  double read_real(Scalar s, const Where& where) {
     if (s == Scalar::Float32) return get<float>(where);
     if (s == Scalar::Float64) return get<double>(where);
     return static_cast<double>(read_int(s, where));
   }
 
-  void skip(Scalar s, const std::string& where) {
+  void skip(Scalar s, const Where& where) {
     need(scalar_size(s), where);
     pos_ += scalar_size(s);
   }
@@ -236,17 +247,17 @@ class BinarySource {
   [[nodiscard]] std::string where_prefix() const { return {}; }
 
  private:
-  void need(std::size_t n, const std::string& where) const {
+  void need(std::size_t n, const Where& where) const {
     if (body_.size() - pos_ < n) {
       throw input_error(file_, 0,
                         fmt::format("{}: truncated, the file ends {} bytes after the header "
                                     "(binary data shorter than the header claims)",
-                                    where, body_.size()));
+                                    where.str(), body_.size()));
     }
   }
 
   template <class T>
-  T get(const std::string& where) {
+  T get(const Where& where) {
     need(sizeof(T), where);
     unsigned char bytes[sizeof(T)];
     std::memcpy(bytes, body_.data() + pos_, sizeof(T));
@@ -272,27 +283,29 @@ class AsciiSource {
   AsciiSource(std::string file, std::string_view body, std::size_t first_line)
       : file_(std::move(file)), body_(body), line_(first_line) {}
 
-  std::int64_t read_int(Scalar s, const std::string& where) {
+  std::int64_t read_int(Scalar s, const Where& where) {
     const std::string_view tok = next(where);
     std::int64_t v = 0;
     if (!parse_int(tok, v)) {
-      throw input_error(file_, token_line_, fmt::format("{}: '{}' is not an integer", where, tok));
+      throw input_error(file_, token_line_,
+                        fmt::format("{}: '{}' is not an integer", where.str(), tok));
     }
     check_range(s, v, tok, where);
     return v;
   }
 
-  double read_real(Scalar s, const std::string& where) {
+  double read_real(Scalar s, const Where& where) {
     if (is_integer(s)) return static_cast<double>(read_int(s, where));
     const std::string_view tok = next(where);
     double v = 0;
     if (!parse_double(tok, v)) {
-      throw input_error(file_, token_line_, fmt::format("{}: '{}' is not a number", where, tok));
+      throw input_error(file_, token_line_,
+                        fmt::format("{}: '{}' is not a number", where.str(), tok));
     }
     return v;
   }
 
-  void skip(Scalar s, const std::string& where) { (void)read_real(s, where); }
+  void skip(Scalar s, const Where& where) { (void)read_real(s, where); }
 
   void finish() {
     skip_space();
@@ -318,13 +331,13 @@ class AsciiSource {
     }
   }
 
-  std::string_view next(const std::string& where) {
+  std::string_view next(const Where& where) {
     skip_space();
     if (pos_ >= body_.size()) {
       throw input_error(file_, line_,
                         fmt::format("{}: the file ends early (fewer values than the header "
                                     "claims)",
-                                    where));
+                                    where.str()));
     }
     const std::size_t start = pos_;
     while (pos_ < body_.size() && body_[pos_] != ' ' && body_[pos_] != '\t' &&
@@ -335,7 +348,7 @@ class AsciiSource {
     return body_.substr(start, pos_ - start);
   }
 
-  void check_range(Scalar s, std::int64_t v, std::string_view tok, const std::string& where) {
+  void check_range(Scalar s, std::int64_t v, std::string_view tok, const Where& where) {
     std::int64_t lo = 0, hi = 0;
     switch (s) {
       case Scalar::Int8:
@@ -360,7 +373,7 @@ class AsciiSource {
     }
     if (v < lo || v > hi) {
       throw input_error(file_, token_line_,
-                        fmt::format("{}: '{}' does not fit the declared type", where, tok));
+                        fmt::format("{}: '{}' does not fit the declared type", where.str(), tok));
     }
   }
 
@@ -459,7 +472,7 @@ TriangleMesh read_body(const std::string& file, const Header& h, const MeshLayou
       return input_error(file, 0, what);
     }
   };
-  std::string where;
+  Where where;
   std::vector<std::int64_t> polygon;
   for (int ei = 0; ei < static_cast<int>(h.elements.size()); ++ei) {
     const Element& e = h.elements[ei];
@@ -467,7 +480,7 @@ TriangleMesh read_body(const std::string& file, const Header& h, const MeshLayou
       double xyz[3] = {0, 0, 0};
       for (int pi = 0; pi < static_cast<int>(e.properties.size()); ++pi) {
         const Property& p = e.properties[pi];
-        where = fmt::format("{} {}, property '{}'", e.name, item, p.name);
+        where = {e.name, item, p.name};
         if (!p.is_list) {
           if (ei == m.vertex_element && (pi == m.x || pi == m.y || pi == m.z)) {
             xyz[pi == m.x ? 0 : pi == m.y ? 1 : 2] = src.read_real(p.type, where);
@@ -477,10 +490,11 @@ TriangleMesh read_body(const std::string& file, const Header& h, const MeshLayou
           continue;
         }
         const std::int64_t n = src.read_int(p.count_type, where);
-        if (n < 0) throw locate(fmt::format("{}: negative list length {}", where, n));
+        if (n < 0) throw locate(fmt::format("{}: negative list length {}", where.str(), n));
         if (ei == m.face_element && pi == m.indices) {
           if (n < 3) {
-            throw locate(fmt::format("{}: a face has {} vertices, expected at least 3", where, n));
+            throw locate(
+                fmt::format("{}: a face has {} vertices, expected at least 3", where.str(), n));
           }
           polygon.clear();
           for (std::int64_t c = 0; c < n; ++c) {
@@ -489,10 +503,10 @@ TriangleMesh read_body(const std::string& file, const Header& h, const MeshLayou
               throw locate(
                   fmt::format("{}: vertex index {} is out of range, expected 0 <= "
                               "index < {}",
-                              where, v, nv));
+                              where.str(), v, nv));
             }
             for (std::int64_t u : polygon) {
-              if (u == v) throw locate(fmt::format("{}: repeats vertex {}", where, v));
+              if (u == v) throw locate(fmt::format("{}: repeats vertex {}", where.str(), v));
             }
             polygon.push_back(v);
           }
