@@ -3,8 +3,9 @@
 
 For each case and thread count, runs the reference and the current binary alternately REPS times,
 checks that both report exactly the same VF and EE collisions (pairs and times of impact), and
-writes a markdown table of medians: refit, traversal, narrow phase, detection (their sum), whole
-process wall time, and the detection's nanoseconds per triangle pair and per feature test.
+writes a markdown table of medians: refit, traversal, narrow phase, detection (their sum), setup
+(reading and building the detector), whole-process wall and CPU time, and the detection's
+nanoseconds per triangle pair and per feature test.
 
 Usage: scripts/detect_speed.py [--ref BIN] [--bin BIN] [--reps N] [--threads 1,2] [--out FILE]
                                [--frames OUT/frames]
@@ -18,6 +19,8 @@ import argparse
 import json
 import os
 import platform
+import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -61,14 +64,21 @@ def cases(data, frames=None):
 
 
 def run(binary, args, threads, json_path):
+    """Wall time, CPU time (user + system) and setup time of one process, and its JSON."""
     cmd = [binary, "detect", *args, "--culling", "sound", "--policy", "proposed", "--threads",
            str(threads), "--json", json_path]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
-    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    out = subprocess.run(cmd, check=True, stdout=subprocess.PIPE, text=True).stdout
     wall = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    # "setup: reading X s, detector Y s" (binaries older than that line: nan).
+    m = re.search(r"setup: reading ([0-9.]+) s, detector ([0-9.]+) s", out)
+    setup = float(m.group(1)) + float(m.group(2)) if m else float("nan")
     with open(json_path) as f:
         res = json.load(f)
-    return wall, res
+    return wall, res, cpu, setup
 
 
 def collisions(res):
@@ -83,12 +93,15 @@ def row(name, threads, label, runs):
     dets = [s["time_refit"] + s["time_traverse"] + s["time_narrow"] for s in st]
     det = statistics.median(dets)
     wall = statistics.median(r[0] for r in runs)
+    cpu = statistics.median(r[2] for r in runs)
+    setup = statistics.median(r[3] for r in runs)
     s = st[0]
     pairs = s["triangle_pairs"]
     tests = s["vf_tests"] + s["ee_tests"]
     return {
         "case": name, "threads": threads, "binary": label, "refit": refit, "traverse": trav,
-        "narrow": narrow, "detect": det, "det_min": min(dets), "det_max": max(dets), "wall": wall, "pairs": pairs, "tests": tests,
+        "narrow": narrow, "detect": det, "det_min": min(dets), "det_max": max(dets), "wall": wall, "cpu": cpu, "setup": setup, "pairs": pairs,
+        "tests": tests,
         "ns_pair": 1e9 * det * threads / max(pairs, 1),
         "ns_test": 1e9 * det * threads / max(tests, 1),
         "collisions": s["vf_collisions"] + s["ee_collisions"],
@@ -148,29 +161,35 @@ def main():
         "`clothcd detect --culling sound --policy proposed`, medians of "
         f"{a.reps} runs{', reference and current alternating' if a.ref else ''}. Detection = "
         "refit + traversal + narrow phase (times in seconds); ns per pair and per test are "
-        "detection time x threads / count (CPU time per candidate). Wall: the whole process "
-        "(reading, tree build, orphans, detection, JSON output)."
+        "detection time x threads / count (CPU time per candidate). Setup: reading the frames "
+        "and building the detector (topology, tree, orphans, ownership), as `clothcd detect` "
+        "prints it (nan for binaries that do not). Wall and CPU: the whole process (reading, "
+        "setup, detection, JSON output), CPU = user + system time of all its threads."
         + (" Every run of both binaries reported the same VF and EE collisions, times of impact "
            "included." if a.ref else ""),
         "",
         "| case | threads | binary | refit | traversal | narrow | detection | detection min-max "
-        "| wall | triangle pairs | feature tests | ns / pair | ns / test | collisions |",
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| setup | wall | CPU | triangle pairs | feature tests | ns / pair | ns / test | "
+        "collisions |",
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         out.append(
             f"| {r['case']} | {r['threads']} | {r['binary']} | {r['refit']:.3f} | "
             f"{r['traverse']:.3f} | {r['narrow']:.3f} | {r['detect']:.3f} | "
-            f"{r['det_min']:.3f}-{r['det_max']:.3f} | {r['wall']:.3f} | "
+            f"{r['det_min']:.3f}-{r['det_max']:.3f} | {r['setup']:.3f} | {r['wall']:.3f} | "
+            f"{r['cpu']:.3f} | "
             f"{r['pairs']:,} | {r['tests']:,} | {r['ns_pair']:.0f} | {r['ns_test']:.0f} | "
             f"{r['collisions']:,} |")
     if a.ref:
         out += ["", "Ratios reference / current (medians):", ""]
-        out += ["| case | threads | detection | narrow | wall |", "|---|---:|---:|---:|---:|"]
+        out += ["| case | threads | detection | narrow | wall | CPU |",
+                "|---|---:|---:|---:|---:|---:|"]
         for cur, ref in zip(rows[0::2], rows[1::2]):
             out.append(f"| {cur['case']} | {cur['threads']} | "
                        f"{ref['detect'] / cur['detect']:.2f}x | "
-                       f"{ref['narrow'] / cur['narrow']:.2f}x | {ref['wall'] / cur['wall']:.2f}x |")
+                       f"{ref['narrow'] / cur['narrow']:.2f}x | {ref['wall'] / cur['wall']:.2f}x | "
+                       f"{ref['cpu'] / cur['cpu']:.2f}x |")
     Path(a.out).write_text("\n".join(out) + "\n")
     print("\n".join(out))
 
