@@ -66,24 +66,48 @@ Topology::Topology(std::vector<Face> faces, int num_vertices)
   validate_faces(faces_, num_vertices_);
   const int nf = num_faces();
 
-  // Half-edges keyed by (larger, smaller) vertex: sorting them yields the unique edges already in
-  // the cloth_ball numbering, and ties by half-edge id keep each edge's faces ascending.
+  // Half-edges keyed by (larger, smaller) vertex: in that order the unique edges come out already
+  // in the cloth_ball numbering, and ties by half-edge id keep each edge's faces ascending. A
+  // counting sort by the larger vertex, then a sort of each vertex's few (smaller, id) words,
+  // gives exactly that order without a comparison sort over all of them.
   struct HalfEdge {
     std::uint64_t key;
     int id;  // 3 * face + k
   };
-  std::vector<HalfEdge> half(static_cast<std::size_t>(nf) * 3);
-  for (int f = 0; f < nf; ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const int a = faces_[f][k], b = faces_[f][(k + 1) % 3];
-      const auto hi = static_cast<std::uint64_t>(std::max(a, b));
-      const auto lo = static_cast<std::uint64_t>(std::min(a, b));
-      half[static_cast<std::size_t>(3 * f + k)] = {(hi << 32) | lo, 3 * f + k};
+  std::vector<int> bucket(static_cast<std::size_t>(num_vertices_) + 1, 0);
+  for (const Face& t : faces_) {
+    for (int k = 0; k < 3; ++k)
+      ++bucket[static_cast<std::size_t>(std::max(t[k], t[(k + 1) % 3])) + 1];
+  }
+  std::partial_sum(bucket.begin(), bucket.end(), bucket.begin());
+  std::vector<std::uint64_t> words(static_cast<std::size_t>(nf) * 3);  // smaller << 32 | id
+  {
+    std::vector<int> cursor(bucket.begin(), bucket.end() - 1);
+    for (int f = 0; f < nf; ++f) {
+      for (int k = 0; k < 3; ++k) {
+        const int a = faces_[f][k], b = faces_[f][(k + 1) % 3];
+        words[static_cast<std::size_t>(cursor[std::max(a, b)]++)] =
+            static_cast<std::uint64_t>(std::min(a, b)) << 32 |
+            static_cast<std::uint64_t>(3 * f + k);
+      }
     }
   }
-  std::sort(half.begin(), half.end(), [](const HalfEdge& x, const HalfEdge& y) {
-    return x.key != y.key ? x.key < y.key : x.id < y.id;
-  });
+  std::vector<HalfEdge> half(words.size());
+  for (int v = 0; v < num_vertices_; ++v) {
+    const auto first = words.begin() + bucket[v], last = words.begin() + bucket[v + 1];
+    if (last - first > 32) {
+      std::sort(first, last);
+    } else {
+      for (auto i = first; i != last; ++i) {  // insertion sort: few words, no allocation
+        for (auto j = i; j != first && *j < *(j - 1); --j)
+          std::iter_swap(j, j - 1);
+      }
+    }
+    for (auto it = first; it != last; ++it) {
+      half[static_cast<std::size_t>(it - words.begin())] = {
+          static_cast<std::uint64_t>(v) << 32 | (*it >> 32), static_cast<int>(*it & 0xffffffffu)};
+    }
+  }
 
   face_edges_.assign(static_cast<std::size_t>(nf), {-1, -1, -1});
   edge_face_offsets_.clear();

@@ -242,6 +242,30 @@ TEST(Topology, RejectsNegativeVertexCount) {
 
 // Random grids with random diagonals, holes, duplicates, non-manifold fins, isolated vertices,
 // shuffled faces and permuted vertex ids.
+TEST(Topology, HubVerticesMatchBruteForce) {
+  // Vertices with many edges (fans of 40 and 100 triangles, both orientations, faces shuffled),
+  // so that one vertex holds more half-edges than the short in-place sort handles.
+  for (const int n : {40, 100}) {
+    for (std::uint32_t seed = 0; seed < 4; ++seed) {
+      std::mt19937 rng(seed);
+      std::vector<Face> faces;
+      // The largest id first: then every spoke's half-edges go to the hub.
+      const int hub = seed < 2 ? n : static_cast<int>(rng() % static_cast<unsigned>(n + 1));
+      std::vector<int> rim;
+      for (int v = 0; v <= n; ++v) {
+        if (v != hub) rim.push_back(v);
+      }
+      for (int i = 0; i < n; ++i) {
+        const int a = rim[static_cast<std::size_t>(i)],
+                  b = rim[static_cast<std::size_t>((i + 1) % n)];
+        faces.push_back(rng() % 2 ? Face{hub, a, b} : Face{b, a, hub});
+      }
+      std::shuffle(faces.begin(), faces.end(), rng);
+      check_against_brute_force(faces, n + 1);
+    }
+  }
+}
+
 TEST(Topology, RandomGridsMatchBruteForce) {
   for (std::uint32_t seed = 0; seed < 40; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
