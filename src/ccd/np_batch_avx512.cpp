@@ -1,5 +1,5 @@
-// np_filter_batch and fast_path_misses with AVX-512 (AVX-512F; called only where the processor has it
-// and FMA): eight queries per instruction. Compiled with -ffp-contract=off: -mfma is there only
+// np_filter_batch and fast_path_misses with AVX-512 (AVX-512F; called only where the processor has
+// it and FMA): eight queries per instruction. Compiled with -ffp-contract=off: -mfma is there only
 // because Eigen's headers require it beside -mavx512f, and no expression is fused.
 #define NP_BATCH_NAMESPACE avx512_impl
 #include "ccd/np_batch_impl.hpp"

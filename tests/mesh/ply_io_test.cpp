@@ -272,7 +272,8 @@ TEST(PlyReadErrors, IndexOutOfRange) {
   for (Enc enc : {Enc::Ascii, Enc::Little, Enc::Big}) {
     ScratchDir dir;
     const auto p = dir.file("oor.ply", triangle_ply(enc, {0, 1, 3}));
-    expect_input_error([&] { (void)read_ply(p); }, {"oor.ply", "face 0, property 'vertex_indices'", "3", "out of range"});
+    expect_input_error([&] { (void)read_ply(p); },
+                       {"oor.ply", "face 0, property 'vertex_indices'", "3", "out of range"});
   }
 }
 
@@ -343,7 +344,8 @@ TEST(PlyReadErrors, BinaryListLengthPastEnd) {
   std::string bytes = triangle_ply(Enc::Little, {0, 1, 2});
   bytes[bytes.size() - 13] = static_cast<char>(200);
   const auto p = dir.file("list.ply", bytes);
-  expect_input_error([&] { (void)read_ply(p); }, {"list.ply", "face 0, property 'vertex_indices'", "truncated"});
+  expect_input_error([&] { (void)read_ply(p); },
+                     {"list.ply", "face 0, property 'vertex_indices'", "truncated"});
 }
 
 TEST(PlyReadErrors, ShortAndUcharIndexTypes) {
