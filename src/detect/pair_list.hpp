@@ -17,8 +17,10 @@ namespace clothcd::detail {
 
 using FacePair = std::pair<int, int>;
 
-/// One thread's pairs: blocks of growing capacity (4 Ki pairs, doubling up to 512 Ki, 4 MiB),
-/// filled in order. clear() empties them and keeps their memory.
+/// One thread's pairs, filled in order into blocks: the first of 64 Ki pairs (512 KiB, enough for
+/// a garment-sized step), the others of 512 Ki pairs (4 MiB: large enough for the command-line
+/// tool to put them on huge pages, whose faults are fewer). clear() empties them and keeps their
+/// memory.
 class PairBlocks {
  public:
   void push(int a, int b) {
@@ -45,12 +47,12 @@ class PairBlocks {
   }
 
  private:
-  static constexpr std::size_t kFirst = std::size_t{1} << 12, kLargest = std::size_t{1} << 19;
+  static constexpr std::size_t kFirst = std::size_t{1} << 16, kLarge = std::size_t{1} << 19;
 
   void next_block() {
     if (used_ == blocks_.size()) {
       blocks_.emplace_back();
-      blocks_.back().reserve(std::min(kFirst << std::min<std::size_t>(used_, 7), kLargest));
+      blocks_.back().reserve(used_ == 0 ? kFirst : kLarge);
     }
     cur_ = &blocks_[used_++];
   }

@@ -33,7 +33,7 @@ void expect_list(const PairList& list, const std::vector<FacePair>& expect) {
     seen.push_back(p);
   });
   EXPECT_EQ(seen, expect);
-  for (const std::size_t piece : {std::size_t{1}, std::size_t{64}, std::size_t{1000}}) {
+  for (const std::size_t piece : {std::size_t{7}, std::size_t{64}, std::size_t{1000}}) {
     std::vector<FacePair> joined;
     for (const PairList::Piece& p : list.pieces(piece)) {
       ASSERT_FALSE(p.pairs.empty());
@@ -52,8 +52,8 @@ PairList list_of(const PairBlocks& b) {
 }
 
 TEST(PairList, BlocksGiveBackEveryPairInOrder) {
-  // Around the first block's capacity (4096) and over several doubling blocks.
-  for (const std::size_t n : {0, 1, 4095, 4096, 4097, 12289, 300000}) {
+  // Around the first block's capacity (65536) and over several of the larger blocks (524288).
+  for (const std::size_t n : {0, 1, 65535, 65536, 65537, 589824, 1200000}) {
     SCOPED_TRACE(n);
     PairBlocks b;
     const auto pairs = numbered(n, 3);
@@ -66,12 +66,12 @@ TEST(PairList, BlocksGiveBackEveryPairInOrder) {
 
 TEST(PairList, ClearKeepsTheMemoryAndForgetsThePairs) {
   PairBlocks b;
-  for (const auto& [x, y] : numbered(50000, 1))
+  for (const auto& [x, y] : numbered(70000, 1))
     b.push(x, y);
   std::vector<std::span<const FacePair>> before;
   b.views(before);
   // Fewer pairs, then more than before: each refill reads back exactly its own pairs.
-  for (const std::size_t n : {std::size_t{10}, std::size_t{0}, std::size_t{70000}}) {
+  for (const std::size_t n : {std::size_t{10}, std::size_t{0}, std::size_t{600000}}) {
     SCOPED_TRACE(n);
     b.clear();
     EXPECT_EQ(b.size(), 0u);
