@@ -13,6 +13,10 @@ Usage: scripts/detect_speed.py [--ref BIN] [--bin BIN] [--reps N] [--threads 1,2
   threads 1,2, output docs/results/detect_speed.md. Data: $CLOTHCD_DATA or ../shared/data.
   --frames: the frames folder of a `scripts/results.sh OUT` run; adds simulated garment frame
   pairs (dress-rumba and multilayer-rumba, frames 60 -> 61, sewn at 1e-3, patch build).
+  --steady-ref TOOL: also time repeated calls on one detector, as a simulator makes them, with
+  build/release/python/tests/clothcd_py_reference against TOOL (the same program built from the
+  reference): one untimed detect(), then 5 timed ones, 3 rounds alternating; cloth_ball and,
+  with --frames, the same garment frames unsewn.
 """
 
 import argparse
@@ -108,6 +112,41 @@ def row(name, threads, label, runs):
     }
 
 
+def steady(ref_tool, frames, rounds=3, runs=5):
+    """Markdown lines: median time of repeated detect() calls on one detector, both tools."""
+    tool = ROOT / "build" / "release" / "python" / "tests" / "clothcd_py_reference"
+    ball = data_dir() / "cloth-ball" / "frames"
+    todo = [("cloth_ball 92 -> 93", [f"t0={ball / 'cloth_ball92.ply'}",
+                                     f"t1={ball / 'cloth_ball93.ply'}", "bvh=spatial"])]
+    for scene, k in SIMULATED if frames else []:
+        f0, f1 = (Path(frames) / scene / f"frame_{i:04d}.obj" for i in (k, k + 1))
+        todo.append((f"{scene} {k} -> {k + 1} (unsewn)", [f"t0={f0}", f"t1={f1}", "bvh=patch"]))
+    lines = ["", "Repeated calls on one detector (a simulator's use): `clothcd_py_reference ... "
+             f"culling=sound policy=proposed runs={runs}`, one untimed detect() and {runs} timed "
+             f"ones per process, {rounds} rounds alternating with the reference; median (min-max) "
+             "of the timed calls in ms. Both report the same VF and EE counts.", "",
+             "| case | threads | reference | current | ratio |", "|---|---:|---:|---:|---:|"]
+    for name, args in todo:
+        for threads in (1, 2):
+            times = {"ref": [], "cur": []}
+            counts = set()
+            for _ in range(rounds):
+                for label, binary in (("ref", ref_tool), ("cur", str(tool))):
+                    cmd = [binary, *args, "culling=sound", "policy=proposed", f"threads={threads}",
+                           f"runs={runs}"]
+                    res = json.loads(subprocess.run(cmd, check=True, capture_output=True,
+                                                    text=True).stdout)
+                    times[label] += res["seconds"]
+                    counts.add((res["vf"], res["ee"]))
+            if len(counts) != 1:
+                sys.exit(f"{name}, {threads} threads: counts differ from the reference")
+            r, c = (statistics.median(times[k]) for k in ("ref", "cur"))
+            span = {k: f"{1e3 * min(v):.1f}-{1e3 * max(v):.1f}" for k, v in times.items()}
+            lines.append(f"| {name} | {threads} | {1e3 * r:.1f} ({span['ref']}) | "
+                         f"{1e3 * c:.1f} ({span['cur']}) | {r / c:.2f}x |")
+    return lines
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--ref")
@@ -116,6 +155,7 @@ def main():
     ap.add_argument("--threads", default="1,2")
     ap.add_argument("--out", default=str(ROOT / "docs" / "results" / "detect_speed.md"))
     ap.add_argument("--frames", help="frames folder of a scripts/results.sh run (OUT/frames)")
+    ap.add_argument("--steady-ref", help="clothcd_py_reference built from the reference")
     a = ap.parse_args()
     bins = [("current", a.bin)] + ([("reference", a.ref)] if a.ref else [])
     rows = []
@@ -190,6 +230,8 @@ def main():
                        f"{ref['detect'] / cur['detect']:.2f}x | "
                        f"{ref['narrow'] / cur['narrow']:.2f}x | {ref['wall'] / cur['wall']:.2f}x | "
                        f"{ref['cpu'] / cur['cpu']:.2f}x |")
+    if a.steady_ref:
+        out += steady(a.steady_ref, a.frames)
     Path(a.out).write_text("\n".join(out) + "\n")
     print("\n".join(out))
 
