@@ -1,10 +1,12 @@
 #!/usr/bin/python3
 """Summarize `clothcd simulate` output folders as a markdown table (one row per folder).
 
-Usage: scripts/sim_summary.py DIR [DIR ...]
+Usage: scripts/sim_summary.py [--parts] DIR [DIR ...]
 Reads each DIR/manifest.json: frames done, seconds per frame (median, mean), the share spent in
 the collision stage, substeps per frame, intersecting pairs (frame 0, worst frame, last frame),
-and unresolved / excluded CCD hits.
+and unresolved / excluded CCD hits. With --parts, a second table says where the collision stage's
+time went (the manifest's collision_parts, summed over frames; runs that predate them are
+skipped).
 """
 import json
 import statistics
@@ -35,20 +37,57 @@ def row(folder: Path) -> str:
     )
 
 
+PARTS = [
+    ("proximity_s", "proximity"),
+    ("ccd_self_s", "CCD self detector"),
+    ("ccd_body_s", "CCD body detector"),
+    ("ccd_hits_s", "hits to contacts"),
+    ("response_s", "response"),
+    ("zones_s", "impact zones"),
+    ("crossings_s", "crossings"),
+    ("setup_s", "setup"),
+]
+
+
+def parts_row(folder: Path) -> str | None:
+    m = json.loads((folder / "manifest.json").read_text())
+    frames = [f for f in m["frames"] if "collision_parts" in f]
+    if not frames:
+        return None
+    col = sum(f["collision_seconds"] for f in frames)
+    sums = {k: sum(f["collision_parts"][k] for f in frames) for k, _ in PARTS}
+    ms = 1000 * col / sum(f["substeps"] for f in frames)
+    cells = [f"{100 * sums[k] / col:.0f}%" if col > 0 else "" for k, _ in PARTS]
+    other = 100 * (col - sum(sums.values())) / col if col > 0 else 0
+    return f"| {m['scene']} | {len(frames)} | {ms:.1f} | " + " | ".join(cells) + f" | {other:.0f}% |"
+
+
 def main() -> int:
-    if len(sys.argv) < 2:
+    args = sys.argv[1:]
+    parts = "--parts" in args
+    args = [a for a in args if a != "--parts"]
+    if not args:
         print(__doc__, file=sys.stderr)
         return 2
     print("| scene | frames | s/frame median / mean | collision share | substeps/frame | "
           "intersecting pairs self / body at frame 0 | worst frame | last frame | "
           "frames with 0 / 0 | unresolved CCD hits |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    for d in sys.argv[1:]:
+    for d in args:
         try:
             print(row(Path(d)))
         except (OSError, KeyError, ValueError) as e:
             print(f"{d}: cannot read manifest.json: {e}", file=sys.stderr)
             return 1
+    if parts:
+        print()
+        print("| scene | frames | collision ms / substep | "
+              + " | ".join(name for _, name in PARTS) + " | between parts |")
+        print("|---|---:|---:|" + "---:|" * (len(PARTS) + 1))
+        for d in args:
+            r = parts_row(Path(d))
+            if r is not None:
+                print(r)
     return 0
 
 

@@ -11,6 +11,7 @@
 #include "sim/contact/detectors.hpp"
 #include "sim/contact/geometry.hpp"
 #include "sim/contact/impact_zones.hpp"
+#include "sim/contact/part_clock.hpp"
 #include "sim/contact/projection.hpp"
 #include "sim/contact/proximity.hpp"
 #include "sim/contact/untangle.hpp"
@@ -26,6 +27,8 @@ struct ContactHandler::Impl {
   detail::ProximityContacts proximity;
   detail::CcdHits ccd;
   detail::ImpactProjection projection;
+  // The parts outside CcdHits (which keeps its own in ccd.times).
+  CollisionPartTimes times;
 
   Impl(const ClothModel& m, const ContactOptions& o)
       : opt(o),
@@ -40,13 +43,21 @@ struct ContactHandler::Impl {
   }
 
   void prepare(const SubstepContext& ctx) {
+    using detail::PartClock;
     const bool body = has_body(ctx);
-    geometry.start(ctx);
-    ccd.excluded = 0;
-    // The crossing count and the escapes need the body's topology, which its detector holds.
-    if (body) detectors.start_body(ctx, geometry);
-    crossings.find(ctx, geometry, opt.self, body);
-    escapes.find(geometry, crossings.body_pairs(), opt.thickness, opt.untangle_step);
+    {
+      PartClock clock(times.setup_s);
+      geometry.start(ctx);
+      ccd.excluded = 0;
+      // The crossing count and the escapes need the body's topology, which its detector holds.
+      if (body) detectors.start_body(ctx, geometry);
+    }
+    {
+      PartClock clock(times.crossings_s);
+      crossings.find(ctx, geometry, opt.self, body);
+      escapes.find(geometry, crossings.body_pairs(), opt.thickness, opt.untangle_step);
+    }
+    PartClock clock(times.proximity_s);
     proximity.find(detectors, escapes, opt.self, body);
   }
 
@@ -57,12 +68,16 @@ struct ContactHandler::Impl {
   }
 
   CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v) {
+    using detail::PartClock;
     CollisionStats st;
-    geometry.start_response(has_body(ctx));
-    // 1. Repulsion and friction on the proximity contacts, then escapes out of the body.
-    st.proximity_pairs = static_cast<long long>(proximity.size());
-    proximity.repel(v);
-    escapes.apply(geometry, v, opt.untangle_step);
+    {
+      PartClock clock(times.response_s);
+      geometry.start_response(has_body(ctx));
+      // 1. Repulsion and friction on the proximity contacts, then escapes out of the body.
+      st.proximity_pairs = static_cast<long long>(proximity.size());
+      proximity.repel(v);
+      escapes.apply(geometry, v, opt.untangle_step);
+    }
     // 2. CCD passes with inelastic projection; later passes test only pairs whose motion changed.
     std::vector<std::uint8_t> touched(geometry.model().num_vertices(), 0);
     std::vector<int> active;
@@ -77,6 +92,7 @@ struct ContactHandler::Impl {
         clean = true;
         break;
       }
+      PartClock clock(times.response_s);
       std::fill(touched.begin(), touched.end(), 0);
       projection.project(hs, v, touched);
       active = detail::flagged(touched);
@@ -85,11 +101,19 @@ struct ContactHandler::Impl {
     if (!clean) {
       const detail::ZoneHits zone_hits =
           [&](std::span<const Vec3> vz, const std::vector<int>* act) { return hits(ctx, vz, act); };
-      detail::resolve_zones(geometry, opt, zone_hits, ccd.sep_scale, v, touched, st);
+      // The zones' own time: less the CCD calls they make, which ccd.times counts.
+      const double before = ccd.times.total();
+      double all = 0.0;
+      {
+        PartClock clock(all);
+        detail::resolve_zones(geometry, opt, zone_hits, ccd.sep_scale, v, touched, st);
+      }
+      times.zones_s += all - (ccd.times.total() - before);
     }
     ccd.sep_scale = 1.0;
     if (opt.self) detectors.self().clear_active_faces();
     st.excluded = ccd.excluded;
+    PartClock clock(times.crossings_s);
     crossings.end(geometry, v, st.unresolved == 0 && ccd.excluded == 0);
     return st;
   }
@@ -127,6 +151,24 @@ SelfProximityFigures& SelfProximityFigures::operator+=(const SelfProximityFigure
   pairs += o.pairs;
   query_s += o.query_s;
   return *this;
+}
+
+CollisionPartTimes& CollisionPartTimes::operator+=(const CollisionPartTimes& o) {
+  setup_s += o.setup_s;
+  crossings_s += o.crossings_s;
+  proximity_s += o.proximity_s;
+  response_s += o.response_s;
+  ccd_self_s += o.ccd_self_s;
+  ccd_body_s += o.ccd_body_s;
+  ccd_hits_s += o.ccd_hits_s;
+  zones_s += o.zones_s;
+  return *this;
+}
+
+CollisionPartTimes ContactHandler::take_part_times() {
+  CollisionPartTimes t = std::exchange(impl_->times, {});
+  t += std::exchange(impl_->ccd.times, {});
+  return t;
 }
 
 SelfCcdFigures ContactHandler::take_self_ccd_figures() {

@@ -276,7 +276,16 @@ nlohmann::json to_json(const FrameStats& s) {
            {{"calls", s.self_proximity.calls},
             {"reused_pairs", s.self_proximity.reused_pairs},
             {"pairs", s.self_proximity.pairs},
-            {"query_s", s.self_proximity.query_s}}}};
+            {"query_s", s.self_proximity.query_s}}},
+          {"collision_parts",
+           {{"setup_s", s.collision_parts.setup_s},
+            {"crossings_s", s.collision_parts.crossings_s},
+            {"proximity_s", s.collision_parts.proximity_s},
+            {"response_s", s.collision_parts.response_s},
+            {"ccd_self_s", s.collision_parts.ccd_self_s},
+            {"ccd_body_s", s.collision_parts.ccd_body_s},
+            {"ccd_hits_s", s.collision_parts.ccd_hits_s},
+            {"zones_s", s.collision_parts.zones_s}}}};
 }
 
 }  // namespace

@@ -85,6 +85,7 @@ FrameStats Simulation::advance_frame() {
   if (contact_) {
     fs.self_ccd = contact_->take_self_ccd_figures();
     fs.self_proximity = contact_->take_self_proximity_figures();
+    fs.collision_parts = contact_->take_part_times();
   }
   state_.time = t1;
   ++frame_;

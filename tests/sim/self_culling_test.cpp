@@ -56,6 +56,27 @@ Frames run(const std::string& culling, const std::string& policy, int threads = 
   return r;
 }
 
+// The collision stage's part times are disjoint pieces of its wall time: each is non-negative,
+// together they stay within collision_seconds, and the self detector's full passes, whose own
+// phase times self_ccd reports, lie inside the self detector's calls.
+TEST(SelfCulling, CollisionPartTimesAreDisjointPiecesOfTheStage) {
+  const Frames r = run("sound", "proposed");
+  for (int f = 0; f < kFrames; ++f) {
+    const FrameStats& s = r.frames[f];
+    const CollisionPartTimes& p = s.collision_parts;
+    for (double x : {p.setup_s, p.crossings_s, p.proximity_s, p.response_s, p.ccd_self_s,
+                     p.ccd_body_s, p.ccd_hits_s, p.zones_s})
+      EXPECT_GE(x, 0.0) << "frame " << f + 1;
+    EXPECT_GT(p.proximity_s, 0.0) << "frame " << f + 1;
+    EXPECT_GT(p.ccd_self_s, 0.0) << "frame " << f + 1;
+    EXPECT_GT(p.ccd_body_s, 0.0) << "frame " << f + 1;
+    EXPECT_LE(p.total(), s.collision_seconds + 1e-9) << "frame " << f + 1;
+    EXPECT_LE(s.self_ccd.refit_s + s.self_ccd.traversal_s + s.self_ccd.narrow_s,
+              p.ccd_self_s + 1e-9)
+        << "frame " << f + 1;
+  }
+}
+
 TEST(SelfCulling, EverySettingGivesTheSameFramesBitwise) {
   const Frames none = run("none", "proposed");
   long long hits = 0, pairs_none = 0;

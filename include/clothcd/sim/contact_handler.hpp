@@ -124,6 +124,25 @@ struct SelfProximityFigures {
   SelfProximityFigures& operator+=(const SelfProximityFigures& o);
 };
 
+/// Where the collision stage's wall time goes, summed over substeps (seconds). The parts do not
+/// overlap and together make up nearly all of CollisionStats::seconds; what they leave out is
+/// bookkeeping between them. They measure, they change nothing.
+struct CollisionPartTimes {
+  double setup_s = 0.0;      ///< contact geometry and the body detector's start of the substep
+  double crossings_s = 0.0;  ///< crossing pairs at the substep start (and escapes), its end's check
+  double proximity_s = 0.0;  ///< proximity queries (self, body) and the contacts built from them
+  double response_s = 0.0;   ///< repulsion, friction, escapes and the inelastic projections
+  double ccd_self_s = 0.0;   ///< the self detector's calls in the CCD passes and impact zones
+  double ccd_body_s = 0.0;   ///< the cloth-body detector's calls there
+  double ccd_hits_s = 0.0;   ///< turning the detectors' hits into contacts (retests, separation)
+  double zones_s = 0.0;      ///< impact zones, less their detector calls and hits
+  [[nodiscard]] double total() const {
+    return setup_s + crossings_s + proximity_s + response_s + ccd_self_s + ccd_body_s + ccd_hits_s +
+           zones_s;
+  }
+  CollisionPartTimes& operator+=(const CollisionPartTimes& o);
+};
+
 class ContactHandler final : public CollisionHandler {
  public:
   /// `model` must outlive the handler; its stitches mark pairs that never collide.
@@ -139,6 +158,8 @@ class ContactHandler final : public CollisionHandler {
   /// The self detector's figures since the last call (zero without self contact); resets them.
   SelfCcdFigures take_self_ccd_figures();
   SelfProximityFigures take_self_proximity_figures();
+  /// The collision stage's part times since the last call; resets them.
+  CollisionPartTimes take_part_times();
 
  private:
   struct Impl;

@@ -42,6 +42,8 @@ struct FrameStats {
   /// SelfCcdFigures: counts depend on the run's history, so a resumed run's may differ).
   SelfCcdFigures self_ccd;
   SelfProximityFigures self_proximity;
+  /// Where collision_seconds went (see CollisionPartTimes).
+  CollisionPartTimes collision_parts;
   /// Intersecting triangle pairs at the frame's end (-1: not counted).
   long long self_intersections = -1;
   long long body_intersections = -1;

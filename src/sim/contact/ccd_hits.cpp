@@ -9,6 +9,7 @@
 
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/ccd/queries.hpp"
+#include "sim/contact/part_clock.hpp"
 
 namespace clothcd::sim::detail {
 namespace {
@@ -38,12 +39,19 @@ constexpr double kNoReach = std::numeric_limits<double>::infinity();
 
 std::vector<Contact> CcdHits::find(std::span<const Vec3> v, const std::vector<int>* active,
                                    bool self, bool body) {
+  // Everything but the detector calls counts as turning hits into contacts.
+  const double detectors = times.ccd_self_s + times.ccd_body_s;
+  double all = 0.0;
   std::vector<Contact> out;
-  std::vector<Vec3> x1(g_.x0.size());
-  for (std::size_t i = 0; i < g_.x0.size(); ++i)
-    x1[i] = g_.x0[i] + g_.h * v[i];
-  if (self) self_hits(x1, v, active, out);
-  if (body) body_hits(x1, v, active, out);
+  {
+    PartClock clock(all);
+    std::vector<Vec3> x1(g_.x0.size());
+    for (std::size_t i = 0; i < g_.x0.size(); ++i)
+      x1[i] = g_.x0[i] + g_.h * v[i];
+    if (self) self_hits(x1, v, active, out);
+    if (body) body_hits(x1, v, active, out);
+  }
+  times.ccd_hits_s += all - (times.ccd_self_s + times.ccd_body_s - detectors);
   return out;
 }
 
@@ -103,7 +111,10 @@ void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
   } else {
     det.clear_active_faces();
   }
-  const DetectResult r = det.detect(g_.x0, x1);
+  const DetectResult r = [&] {
+    PartClock clock(times.ccd_self_s);
+    return det.detect(g_.x0, x1);
+  }();
   if (active == nullptr) {
     det_.self_pass_done();
     SelfCcdFigures& f = det_.self_ccd_figures;
@@ -159,7 +170,10 @@ void CcdHits::body_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
   } else {
     det.clear_active();
   }
-  const PairDetectResult r = det.detect(g_.x0, x1, g_.b0, g_.b1);
+  const PairDetectResult r = [&] {
+    PartClock clock(times.ccd_body_s);
+    return det.detect(g_.x0, x1, g_.b0, g_.b1);
+  }();
   const auto& cf = g_.cloth().faces();
   const auto& bf = g_.body().faces();
   const auto& ce = g_.cloth().edges();

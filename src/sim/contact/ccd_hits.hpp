@@ -32,6 +32,8 @@ class CcdHits {
   double sep_scale = 1.0;
   /// Hits excluded this substep (tangled, or touching at t0); reset by the caller.
   long long excluded = 0;
+  /// Where find() spends its time: ccd_self_s, ccd_body_s and ccd_hits_s grow, the rest stays 0.
+  CollisionPartTimes times;
 
   // What becomes of one hit of a detector.
   struct Hit {
