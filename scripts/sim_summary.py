@@ -6,7 +6,8 @@ Reads each DIR/manifest.json: frames done, seconds per frame (median, mean), the
 the collision stage, substeps per frame, intersecting pairs (frame 0, worst frame, last frame),
 and unresolved / excluded CCD hits. With --parts, a second table says where the collision stage's
 time went (the manifest's collision_parts, summed over frames; runs that predate them are
-skipped).
+skipped), and a third splits the self detector's part: its full CCD passes' phases and its
+proximity query.
 """
 import json
 import statistics
@@ -62,6 +63,33 @@ def parts_row(folder: Path) -> str | None:
     return f"| {m['scene']} | {len(frames)} | {ms:.1f} | " + " | ".join(cells) + f" | {other:.0f}% |"
 
 
+def self_row(folder: Path) -> str | None:
+    m = json.loads((folder / "manifest.json").read_text())
+    frames = [f for f in m["frames"] if "collision_parts" in f]
+    if not frames:
+        return None
+    ccd = [f["self_ccd"] for f in frames]
+    prox = [f["self_proximity"] for f in frames]
+    calls = sum(c["calls"] for c in ccd)
+    pcalls = sum(p["calls"] for p in prox)
+    if calls == 0 or pcalls == 0:
+        return None
+
+    def per_call(key: str) -> str:
+        return f"{1000 * sum(c[key] for c in ccd) / calls:.1f}"
+
+    full = sum(c["refit_s"] + c["traversal_s"] + c["narrow_s"] for c in ccd)
+    self_ccd = sum(f["collision_parts"]["ccd_self_s"] for f in frames)
+    query = sum(p["query_s"] for p in prox)
+    proximity = sum(f["collision_parts"]["proximity_s"] for f in frames)
+    return (
+        f"| {m['scene']} | {calls} | {sum(c['triangle_pairs'] for c in ccd) // calls} | "
+        f"{per_call('refit_s')} | {per_call('traversal_s')} | {per_call('narrow_s')} | "
+        f"{100 * full / self_ccd:.0f}% | {1000 * query / pcalls:.1f} | "
+        f"{100 * query / proximity:.0f}% |"
+    )
+
+
 def main() -> int:
     args = sys.argv[1:]
     parts = "--parts" in args
@@ -86,6 +114,18 @@ def main() -> int:
         print("|---|---:|---:|" + "---:|" * (len(PARTS) + 1))
         for d in args:
             r = parts_row(Path(d))
+            if r is not None:
+                print(r)
+        print()
+        print("Self detector: its full CCD passes (the first of each substep) per call, their "
+              "share of all its CCD calls' time, and its proximity query per call and share of "
+              "the proximity part (the rest: the cloth-body query and the contacts built).")
+        print()
+        print("| scene | full passes | triangle pairs / pass | refit ms | traversal ms | "
+              "narrow ms | share of CCD self | proximity query ms | share of proximity |")
+        print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+        for d in args:
+            r = self_row(Path(d))
             if r is not None:
                 print(r)
     return 0
