@@ -132,7 +132,7 @@ struct CollisionPartTimes {
   double crossings_s = 0.0;  ///< crossing pairs at the substep start (and escapes), its end's check
   double proximity_s = 0.0;  ///< proximity queries (self, body) and the contacts built from them
   double response_s = 0.0;   ///< repulsion, friction, escapes and the inelastic projections
-  double ccd_self_s = 0.0;   ///< the self detector's calls in the CCD passes and impact zones
+  double ccd_self_s = 0.0;   ///< the self detector's calls (and active sets) in CCD passes, zones
   double ccd_body_s = 0.0;   ///< the cloth-body detector's calls there
   double ccd_hits_s = 0.0;   ///< turning the detectors' hits into contacts (retests, separation)
   double zones_s = 0.0;      ///< impact zones, less their detector calls and hits

@@ -106,13 +106,14 @@ CcdHits::Hit CcdHits::settle(bool dropped, bool tangled, double toi, const Query
 void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
                         const std::vector<int>* active, std::vector<Contact>& out) {
   SelfDetector& det = det_.self();
-  if (active != nullptr) {
-    det.set_active_vertices(*active);
-  } else {
-    det.clear_active_faces();
-  }
+  // The restriction to the active vertices is the detector's work too.
   const DetectResult r = [&] {
     PartClock clock(times.ccd_self_s);
+    if (active != nullptr) {
+      det.set_active_vertices(*active);
+    } else {
+      det.clear_active_faces();
+    }
     return det.detect(g_.x0, x1);
   }();
   if (active == nullptr) {
@@ -165,13 +166,13 @@ void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
 void CcdHits::body_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
                         const std::vector<int>* active, std::vector<Contact>& out) {
   PairDetector& det = det_.body();
-  if (active != nullptr) {
-    det.set_active_vertices(*active);
-  } else {
-    det.clear_active();
-  }
   const PairDetectResult r = [&] {
     PartClock clock(times.ccd_body_s);
+    if (active != nullptr) {
+      det.set_active_vertices(*active);
+    } else {
+      det.clear_active();
+    }
     return det.detect(g_.x0, x1, g_.b0, g_.b1);
   }();
   const auto& cf = g_.cloth().faces();
