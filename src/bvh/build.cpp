@@ -277,8 +277,13 @@ void Bvh::build_tree(const Topology& topology, std::span<const Eigen::Vector3d> 
   }
   level_offsets_.push_back(static_cast<int>(nodes_.size()));
   leaf_of_face_.assign(topology.num_faces(), -1);
+  parent_.assign(nodes_.size(), -1);
   for (int i = 0; i < static_cast<int>(nodes_.size()); ++i) {
-    if (nodes_[i].is_leaf()) leaf_of_face_[prim_ids_[nodes_[i].first]] = i;
+    if (nodes_[i].is_leaf()) {
+      leaf_of_face_[prim_ids_[nodes_[i].first]] = i;
+    } else {
+      parent_[nodes_[i].left] = parent_[nodes_[i].left + 1] = i;
+    }
   }
   cones_.resize(nodes_.size());
   faces_ = topology.faces();

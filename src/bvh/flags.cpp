@@ -35,10 +35,14 @@ int Bvh::num_disk_internal() const {
 
 std::vector<std::uint8_t> Bvh::nodes_holding(std::span<const std::uint8_t> face_flags) const {
   std::vector<std::uint8_t> out(nodes_.size(), 0);
-  // Children come after their parent, so a backward sweep sees both before the parent.
-  for (int i = static_cast<int>(nodes_.size()) - 1; i >= 0; --i) {
-    const BvhNode& n = nodes_[i];
-    out[i] = n.is_leaf() ? face_flags[prim_ids_[n.first]] : (out[n.left] | out[n.left + 1]);
+  // From each flagged face's leaf upwards, until a node already holds its bits: that node's
+  // ancestors hold them too (every node written holds the OR of what was written below it).
+  const std::size_t n = std::min(face_flags.size(), leaf_of_face_.size());
+  for (std::size_t f = 0; f < n; ++f) {
+    const std::uint8_t bits = face_flags[f];
+    if (bits == 0) continue;
+    for (int i = leaf_of_face_[f]; i >= 0 && (out[i] & bits) != bits; i = parent_[i])
+      out[i] |= bits;
   }
   return out;
 }

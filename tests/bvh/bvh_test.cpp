@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
+#include <random>
 #include <set>
 
 #include "clothcd/bvh/bvh.hpp"
@@ -94,6 +95,36 @@ TEST(Bvh, StructureAndFlagsMatchBruteForce) {
 
 // The connectivity flag on random meshes: boundaries, edges of three or more faces, duplicate
 // faces, several components, faces scattered in space so that splits cut them apart.
+// nodes_holding against its definition: each node's flag is the OR of the flags of the faces in
+// its range, for flags of several bits on none, few, many and all of the faces.
+TEST(Bvh, NodesHoldingIsTheOrOfTheFlagsBelow) {
+  std::mt19937_64 rng(5);
+  for (const auto& s : {crumpled_sheet(10, 3), twisted_strip(30, 3)}) {
+    const Topology topo(s.faces, s.num_vertices);
+    const auto v0 = points(s.v_t0);
+    for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+      const Bvh bvh(topo, v0, build);
+      for (int share : {0, 1, 8, 100}) {
+        SCOPED_TRACE(::testing::Message()
+                     << s.name << " build " << int(build) << " share " << share);
+        std::vector<std::uint8_t> flags(topo.num_faces(), 0);
+        for (auto& f : flags) {
+          if (static_cast<int>(rng() % 100) < share) f = static_cast<std::uint8_t>(1 + rng() % 7);
+        }
+        const std::vector<std::uint8_t> held = bvh.nodes_holding(flags);
+        ASSERT_EQ(held.size(), bvh.nodes().size());
+        for (int i = 0; i < static_cast<int>(held.size()); ++i) {
+          const BvhNode& n = bvh.nodes()[i];
+          std::uint8_t expected = 0;
+          for (int k = n.first; k < n.first + n.count; ++k)
+            expected |= flags[bvh.prim_ids()[k]];
+          EXPECT_EQ(held[i], expected) << "node " << i;
+        }
+      }
+    }
+  }
+}
+
 TEST(Bvh, ConnectedFlagMatchesBruteForceOnRandomMeshes) {
   int connected = 0, disconnected = 0;
   for (std::uint64_t seed = 1; seed <= 80; ++seed) {

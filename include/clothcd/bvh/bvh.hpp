@@ -132,7 +132,9 @@ class Bvh {
   [[nodiscard]] int num_internal() const;
   [[nodiscard]] int num_connected_internal() const;
   [[nodiscard]] int num_disk_internal() const;
-  /// One flag per node: set when a face below it is flagged in `face_flags` (one per face).
+  /// One flag per node: set when a face below it is flagged in `face_flags` (one per face); the
+  /// OR of the flags of the faces below it. Costs a pass over `face_flags` and, per flagged face,
+  /// the nodes above it not yet flagged: cheap when few faces are (a restricted CCD pass).
   [[nodiscard]] std::vector<std::uint8_t> nodes_holding(
       std::span<const std::uint8_t> face_flags) const;
 
@@ -177,6 +179,7 @@ class Bvh {
   std::vector<BvhNode> nodes_;
   std::vector<int> prim_ids_;
   std::vector<int> leaf_of_face_;
+  std::vector<int> parent_;  // -1 for the root
   std::vector<int> level_offsets_;
   std::vector<int> contour_offsets_;  // CSR per node
   std::vector<int> contour_vertices_;
