@@ -50,9 +50,14 @@ PARTS = [
 ]
 
 
-def parts_row(folder: Path) -> str | None:
+def with_parts(folder: Path) -> tuple[dict, list]:
+    """The manifest and its frames that have collision_parts."""
     m = json.loads((folder / "manifest.json").read_text())
-    frames = [f for f in m["frames"] if "collision_parts" in f]
+    return m, [f for f in m["frames"] if "collision_parts" in f]
+
+
+def parts_row(folder: Path) -> str | None:
+    m, frames = with_parts(folder)
     if not frames:
         return None
     col = sum(f["collision_seconds"] for f in frames)
@@ -64,8 +69,7 @@ def parts_row(folder: Path) -> str | None:
 
 
 def self_row(folder: Path) -> str | None:
-    m = json.loads((folder / "manifest.json").read_text())
-    frames = [f for f in m["frames"] if "collision_parts" in f]
+    m, frames = with_parts(folder)
     if not frames:
         return None
     ccd = [f["self_ccd"] for f in frames]

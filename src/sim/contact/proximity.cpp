@@ -3,8 +3,9 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
+
+#include "sim/contact/part_clock.hpp"
 
 namespace clothcd::sim::detail {
 
@@ -16,10 +17,11 @@ void ProximityContacts::find(ContactDetectors& detectors, const Escapes& escapes
   const std::span<const Vec3> none;
   if (self) {
     SelfDetector& det = detectors.start_self(g_);
-    const auto t = std::chrono::steady_clock::now();
-    const ProximityResult r = det.proximity(g_.x0, opt_.thickness);
     SelfProximityFigures& f = detectors.self_proximity_figures;
-    f.query_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+    const ProximityResult r = [&] {
+      PartClock clock(f.query_s);
+      return det.proximity(g_.x0, opt_.thickness);
+    }();
     ++f.calls;
     f.reused_pairs += static_cast<long long>(r.reused_pairs);
     f.pairs += static_cast<long long>(r.vf.size() + r.ee.size());
