@@ -2,6 +2,7 @@
 
 #include "ccd/certify.hpp"
 #include "ccd/fast_path.hpp"
+#include "ccd/isa.hpp"
 
 // Without xsimd or off x86-64 (CLOTHCD_NP_BATCH_X86 unset) the batch runs the scalar filter.
 
@@ -71,18 +72,6 @@ void fast_path_misses_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdi
     miss[i] = fast_path_miss_scalar(kind, points);
   }
 }
-
-#if CLOTHCD_NP_BATCH_X86
-bool has_avx2() {
-  static const bool yes = __builtin_cpu_supports("avx2") != 0;
-  return yes;
-}
-bool has_avx512() {
-  static const bool yes =
-      __builtin_cpu_supports("avx512f") != 0 && __builtin_cpu_supports("fma") != 0;
-  return yes;
-}
-#endif
 
 }  // namespace
 

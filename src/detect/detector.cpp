@@ -75,7 +75,9 @@ struct NarrowBuffer {
   detail::FeatureCounters c;
   std::vector<VertexFaceCollision> vf;
   std::vector<EdgeEdgeCollision> ee;
-  detail::FeatureBatch batch;  // the pair loop's feature pairs, NP-filtered a batch at a time
+  detail::FeatureBatch batch;     // the pair loop's feature pairs, NP-filtered a batch at a time
+  detail::FacesApartBatch faces;  // its triangle pairs, distance-filtered a batch at a time
+  detail::FaceBoundBatch near;    // ... those whose boxes miss, bounded at t1 a batch at a time
 };
 
 }  // namespace
@@ -313,12 +315,61 @@ struct SelfDetector::Impl {
       }
       triangle_pair(ctx, f, g, out, kvf, kee);
     };
+    // With the distance filter, pairs [k0, k1) of a piece: the box test and the queueing of the
+    // pairs past it, the whole-triangle filter on them at once, then their feature pairs, in
+    // list order (the results and counters are one's).
+    const auto batch = [&](std::size_t first, std::span<const detail::FacePair> piece,
+                           std::size_t k0, std::size_t k1, NarrowBuffer& out) {
+      detail::FacesApartBatch& fb = out.faces;
+      detail::FaceBoundBatch& nb = out.near;
+      for (std::size_t k = k0; k < k1; ++k) {
+        if (k + kFar < piece.size()) {
+          fetch_face(piece[k + kFar].first);
+          fetch_face(piece[k + kFar].second);
+        }
+        const auto [f, g] = piece[k];
+        fb.slot[k - k0] = nb.slot[k - k0] = -1;
+        if (wide && !detail::overlap(ctx.face_boxes[f].face(), ctx.face_boxes[g].face())) {
+          if (near != nullptr) nb.slot[k - k0] = nb.push(ctx.v1, faces[f], ctx.v1, faces[g]);
+          continue;
+        }
+        fb.slot[k - k0] = fb.push(ctx.v0, ctx.v1, faces[f], ctx.v0, ctx.v1, faces[g]);
+      }
+      if (nb.pairs.size > 0) {
+        nb.run();
+        for (std::size_t k = k0; k < k1; ++k) {
+          const int s = nb.slot[k - k0];
+          if (s >= 0) (*near)[first + k] = !(nb.bound[s] > opt.reuse_distance);
+        }
+      }
+      fb.run(ctx.ccd.thickness);
+      for (std::size_t k = k0; k < k1; ++k) {
+        const int s = fb.slot[k - k0];
+        if (s < 0) continue;
+        ++out.c.triangle_pairs;
+        if (near != nullptr) (*near)[first + k] = !(fb.bound_t1[s] > opt.reuse_distance);
+        if (fb.apart[s]) {
+          ++out.c.faces_apart;
+          continue;
+        }
+        triangle_pair(ctx, piece[k].first, piece[k].second, out, kvf, kee);
+      }
+    };
+    const bool batched = ctx.distance_filter();
+    constexpr std::size_t kBatch = detail::FacesApartBatch::kCapacity;
     const std::vector<detail::PairList::Piece> pieces = pairs.pieces(kPiece);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces.size(), 1),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         NarrowBuffer& out = locals.local();
                         for (std::size_t p = r.begin(); p != r.end(); ++p) {
                           const std::span<const detail::FacePair> piece = pieces[p].pairs;
+                          if (batched) {
+                            for (std::size_t k0 = 0; k0 < piece.size(); k0 += kBatch) {
+                              batch(pieces[p].first, piece, k0, std::min(piece.size(), k0 + kBatch),
+                                    out);
+                            }
+                            continue;
+                          }
                           for (std::size_t k = 0; k < piece.size(); ++k) {
                             if (k + kFar < piece.size()) {
                               fetch_face(piece[k + kFar].first);
@@ -694,6 +745,7 @@ struct SelfDetector::Impl {
     struct Buffer {
       std::vector<ProximityResult::VertexFace> vf;
       std::vector<ProximityResult::EdgeEdge> ee;
+      detail::FaceBoundBatch bounds;  // a piece's triangle pairs past the box test
     };
     tbb::enumerable_thread_specific<Buffer> locals;
     auto kvf = [&](int v, int f, const Face& t, Buffer& out) {
@@ -704,21 +756,29 @@ struct SelfDetector::Impl {
       const double d = edge_edge_distance_if_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
       if (d <= h) out.ee.push_back({a, b, d});
     };
+    // A piece at a time: the box test, the whole triangles' bound of the pairs past it at once
+    // (no feature pair is closer), then the feature pairs of those within h, in list order.
     auto test_pairs = [&](const detail::PairList& pairs) {
-      const std::vector<detail::PairList::Piece> pieces = pairs.pieces(64);
+      const std::vector<detail::PairList::Piece> pieces =
+          pairs.pieces(detail::FaceBoundBatch::kCapacity);
+      const auto& faces = topo.faces();
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces.size(), 1),
                         [&](const tbb::blocked_range<std::size_t>& r) {
                           Buffer& out = locals.local();
+                          detail::FaceBoundBatch& nb = out.bounds;
                           for (std::size_t p = r.begin(); p != r.end(); ++p) {
-                            for (const auto& [f, g] : pieces[p].pairs) {
-                              if (!detail::overlap(ctx.fboxes[f], ctx.fboxes[g])) continue;
-                              // No feature pair is closer than the whole triangles' bound.
-                              const Face &a = topo.faces()[f], &b = topo.faces()[g];
-                              if (detail::triangle_triangle_bound(detail::corners(v0, a),
-                                                                  detail::corners(v0, b)) > h) {
-                                continue;
-                              }
-                              triangle_pair(ctx, f, g, out, kvf, kee);
+                            const std::span<const detail::FacePair> piece = pieces[p].pairs;
+                            for (std::size_t k = 0; k < piece.size(); ++k) {
+                              const auto [f, g] = piece[k];
+                              nb.slot[k] = detail::overlap(ctx.fboxes[f], ctx.fboxes[g])
+                                               ? nb.push(v0, faces[f], v0, faces[g])
+                                               : -1;
+                            }
+                            nb.run();
+                            for (std::size_t k = 0; k < piece.size(); ++k) {
+                              const int s = nb.slot[k];
+                              if (s < 0 || nb.bound[s] > h) continue;
+                              triangle_pair(ctx, piece[k].first, piece[k].second, out, kvf, kee);
                             }
                           }
                         });

@@ -23,6 +23,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "ccd/face_batch.hpp"
 #include "ccd/face_bounds.hpp"
 #include "ccd/np_batch.hpp"
 #include "clothcd/bvh/aabb.hpp"
@@ -69,6 +70,53 @@ struct FeatureBatch {
   std::array<std::pair<int, int>, kCapacity> vf_ids, ee_ids;
   std::array<ccd_detail::NpVerdict, kCapacity> verdict;
   std::array<bool, kCapacity> miss;  // ccd_detail::fast_path_misses
+};
+
+/// Triangle pairs waiting for the whole-triangle distance filter (FeatureContext::faces_apart),
+/// which `run` applies to a batch at a time, vectorised (face_batch.hpp: the scalar verdicts and
+/// bounds bit for bit); one per thread. `slot[k]`: where the caller's k-th pair of a piece went
+/// (-1: not queued).
+struct FacesApartBatch {
+  static constexpr int kCapacity = FacePairBatch::kCapacity;
+  FacePairBatch pairs;
+  std::array<bool, kCapacity> apart{};
+  std::array<double, kCapacity> bound_t1{};
+  std::array<int, kCapacity> slot{};
+
+  /// Queues triangle a (positions a0 at t0, a1 at t1) against triangle b; returns its slot.
+  int push(std::span<const Eigen::Vector3d> a0, std::span<const Eigen::Vector3d> a1, const Face& a,
+           std::span<const Eigen::Vector3d> b0, std::span<const Eigen::Vector3d> b1,
+           const Face& b) {
+    pairs.push(corners(a0, a), corners(a1, a), corners(b0, b), corners(b1, b));
+    return pairs.size - 1;
+  }
+  /// Filters the queued pairs at `thickness` into apart and bound_t1, and empties the queue.
+  void run(double thickness) {
+    triangles_filter_batch(pairs, thickness, apart.data(), bound_t1.data());
+    pairs.size = 0;
+  }
+};
+
+/// Triangle pairs at one time waiting for their whole-triangle distance bound
+/// (triangle_triangle_bound), which `run` computes for a batch at a time, vectorised
+/// (face_batch.hpp, bit for bit); one per thread. `slot` as in FacesApartBatch.
+struct FaceBoundBatch {
+  static constexpr int kCapacity = StaticFacePairBatch::kCapacity;
+  StaticFacePairBatch pairs;
+  std::array<double, kCapacity> bound{};
+  std::array<int, kCapacity> slot{};
+
+  /// Queues face a (positions x) against face b (positions y); returns its slot.
+  int push(std::span<const Eigen::Vector3d> x, const Face& a, std::span<const Eigen::Vector3d> y,
+           const Face& b) {
+    pairs.push(corners(x, a), corners(y, b));
+    return pairs.size - 1;
+  }
+  /// Bounds the queued pairs into `bound`, and empties the queue.
+  void run() {
+    triangle_bound_batch(pairs, bound.data());
+    pairs.size = 0;
+  }
 };
 
 /// One face's feature boxes for a step, side by side as float lanes: coordinate c of the boxes'

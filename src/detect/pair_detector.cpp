@@ -130,6 +130,7 @@ void face_pair(const detail::FeatureContext& ca, const detail::FeatureContext& c
 
 struct Buffer {
   detail::FeatureCounters c;
+  detail::FacesApartBatch faces;  // triangle pairs, distance-filtered a batch at a time
   std::vector<VertexFaceCollision> ab, ba;
   std::vector<EdgeEdgeCollision> ee;
 };
@@ -258,20 +259,27 @@ struct PairDetector::Impl {
     b.boxes.update(cb, b.step);
     tbb::enumerable_thread_specific<Buffer> locals;
     const Scope scope{*this};
+    const bool batched = ca.distance_filter();
+    constexpr std::size_t kBatch = detail::FacesApartBatch::kCapacity;
     tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+        tbb::blocked_range<std::size_t>(0, pairs.size(), kBatch),
         [&](const tbb::blocked_range<std::size_t>& r) {
           Buffer& out = locals.local();
+          detail::FacesApartBatch& apart = out.faces;
           for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const auto [fa, fb] = pairs[i];
-            // The distance filter on whole triangles first: where it culls, it culls each of
-            // their feature pairs.
-            if (ca.distance_filter() &&
-                detail::triangles_filter_culls(detail::corners(a.x0, a.topo.faces()[fa]),
-                                               detail::corners(a.x1, a.topo.faces()[fa]),
-                                               detail::corners(b.x0, b.topo.faces()[fb]),
-                                               detail::corners(b.x1, b.topo.faces()[fb]),
-                                               opt.thickness)) {
+            // The distance filter on whole triangles first, a batch of pairs at a time: where it
+            // culls, it culls each of their feature pairs.
+            const std::size_t k = (i - r.begin()) % kBatch;
+            if (batched && k == 0) {
+              const std::size_t end = std::min(r.end(), i + kBatch);
+              for (std::size_t j = i; j != end; ++j) {
+                const auto [x, y] = pairs[j];
+                apart.push(a.x0, a.x1, a.topo.faces()[x], b.x0, b.x1, b.topo.faces()[y]);
+              }
+              apart.run(opt.thickness);
+            }
+            if (batched && apart.apart[k]) {
               ++out.c.faces_apart;
               continue;
             }
@@ -326,22 +334,30 @@ struct PairDetector::Impl {
     struct Found {
       std::vector<ProximityResult::VertexFace> ab, ba;
       std::vector<ProximityResult::EdgeEdge> ee;
+      detail::FaceBoundBatch bounds;  // triangle pairs, bounded a batch at a time
     };
     tbb::enumerable_thread_specific<Found> locals;
     const Scope scope{*this};
     const auto& xa = a.x0;
     const auto& xb = b.x0;
+    constexpr std::size_t kBatch = detail::FaceBoundBatch::kCapacity;
     tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, pairs.size(), 64),
+        tbb::blocked_range<std::size_t>(0, pairs.size(), kBatch),
         [&](const tbb::blocked_range<std::size_t>& r) {
           Found& out = locals.local();
+          detail::FaceBoundBatch& nb = out.bounds;
           for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const auto [f, g] = pairs[i];
-            // No feature pair is closer than the whole triangles' bound.
-            if (detail::triangle_triangle_bound(detail::corners(xa, faces_a[f]),
-                                                detail::corners(xb, faces_b[g])) > h) {
-              continue;
+            // No feature pair is closer than the whole triangles' bound, computed for a batch
+            // of pairs at a time.
+            const std::size_t k = (i - r.begin()) % kBatch;
+            if (k == 0) {
+              const std::size_t end = std::min(r.end(), i + kBatch);
+              for (std::size_t j = i; j != end; ++j)
+                nb.push(xa, faces_a[pairs[j].first], xb, faces_b[pairs[j].second]);
+              nb.run();
             }
+            if (nb.bound[k] > h) continue;
             face_pair(
                 ca, cb, f, g, scope,
                 [&](int v, int k) {
