@@ -297,7 +297,7 @@ struct SelfDetector::Impl {
     // Pair i of the list, faces f and g.
     const auto one = [&](std::size_t i, int f, int g, NarrowBuffer& out) {
       // Widened leaf boxes: no feature pair of faces whose own boxes miss.
-      if (wide && !detail::overlap(ctx.face_boxes[f].face(), ctx.face_boxes[g].face())) {
+      if (wide && !ctx.face_boxes[f].face_overlaps(ctx.face_boxes[g])) {
         if (near != nullptr) {
           (*near)[i] = !(detail::triangle_triangle_bound(detail::corners(v1, faces[f]),
                                                          detail::corners(v1, faces[g])) >
@@ -329,7 +329,7 @@ struct SelfDetector::Impl {
         }
         const auto [f, g] = piece[k];
         fb.slot[k - k0] = nb.slot[k - k0] = -1;
-        if (wide && !detail::overlap(ctx.face_boxes[f].face(), ctx.face_boxes[g].face())) {
+        if (wide && !ctx.face_boxes[f].face_overlaps(ctx.face_boxes[g])) {
           if (near != nullptr) nb.slot[k - k0] = nb.push(ctx.v1, faces[f], ctx.v1, faces[g]);
           continue;
         }

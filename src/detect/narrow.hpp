@@ -144,6 +144,14 @@ struct alignas(64) FaceBoxes {
     return b;
   }
   [[nodiscard]] Box face() const { return get(kFace); }
+  /// overlap(face(), o.face()), read in place: the same ordered comparisons (false on NaN),
+  /// without building the two boxes (whose scalar stores a vector load would wait on).
+  [[nodiscard]] bool face_overlaps(const FaceBoxes& o) const {
+    bool all = true;
+    for (int c = 0; c < 3; ++c)
+      all = all && lo[c][kFace] <= o.hi[c][kFace] && o.lo[c][kFace] <= hi[c][kFace];
+    return all;
+  }
 };
 
 /// Positions of one step and the test settings.

@@ -1,7 +1,7 @@
-// The pair loop's box blocks (detail::FaceBoxes, feature_overlaps, StepFaceBoxes) against the
-// separate boxes and the scalar box test: the same overlap bits on random blocks (ties and NaN
-// included), and on procedural meshes and random triangles the same blocks as the boxes they
-// gather, after full and partial updates, and the same feature pairs from owned_feature_pairs;
+// The pair loop's box blocks (detail::FaceBoxes, feature_overlaps, face_overlaps, StepFaceBoxes)
+// against the separate boxes and the scalar box test: the same overlap bits on random blocks (ties
+// and NaN included), and on procedural meshes and random triangles the same blocks as the boxes
+// they gather, after full and partial updates, and the same feature pairs from owned_feature_pairs;
 // the ownership search masks (search_masks) against their scalar form.
 
 #include <gtest/gtest.h>
@@ -33,7 +33,7 @@ TEST(FaceBoxes, VectorOverlapsEqualTheScalarTestOnRandomBlocks) {
                           -std::numeric_limits<float>::infinity(),
                           std::numeric_limits<float>::quiet_NaN()};
   test::Gen gen(11);
-  std::size_t vf = 0, ee = 0;
+  std::size_t vf = 0, ee = 0, faces_overlap = 0;
   for (int n = 0; n < 200000; ++n) {
     detail::FaceBoxes a, b;
     const bool odd = n % 8 == 0;  // now and then NaN and infinities
@@ -50,11 +50,15 @@ TEST(FaceBoxes, VectorOverlapsEqualTheScalarTestOnRandomBlocks) {
     }
     const detail::FeatureOverlaps want = detail::feature_overlaps_scalar(a, b);
     ASSERT_EQ(detail::feature_overlaps(a, b), want) << "block pair " << n;
+    ASSERT_EQ(a.face_overlaps(b), detail::overlap(a.face(), b.face())) << "block pair " << n;
+    faces_overlap += a.face_overlaps(b) ? 1 : 0;
     vf += static_cast<std::size_t>(std::popcount(want.vf_f) + std::popcount(want.vf_g));
     ee += static_cast<std::size_t>(std::popcount(want.ee));
   }
   EXPECT_GT(vf, 10000u);
   EXPECT_GT(ee, 10000u);
+  EXPECT_GT(faces_overlap, 10000u);
+  EXPECT_LT(faces_overlap, 190000u);
 }
 
 // Every pair of faces of `faces` sharing no vertex through face_boxes_check::check_pair, over a
