@@ -208,12 +208,19 @@ struct PairDetector::Impl {
     }
   };
 
-  // Overlapping leaf pairs (face of A, face of B), below active nodes when restricted.
-  std::vector<std::pair<int, int>> traverse(DetectStats& st) const {
-    struct Pairs {
-      std::vector<std::pair<int, int>> v;
-    };
-    std::vector<std::pair<int, int>> pairs;
+  // The traversal's output, kept from call to call so that a simulation's calls reuse its
+  // memory (fresh vectors of this size come from the system, page by page, at every call).
+  struct Pairs {
+    std::vector<std::pair<int, int>> v;
+  };
+  tbb::enumerable_thread_specific<Pairs> pair_locals;
+  std::vector<std::pair<int, int>> pairs_found;
+
+  // Overlapping leaf pairs (face of A, face of B), below active nodes when restricted; valid
+  // until the next call.
+  const std::vector<std::pair<int, int>>& traverse(DetectStats& st) {
+    std::vector<std::pair<int, int>>& pairs = pairs_found;
+    pairs.clear();
     const auto& na = a.bvh.nodes();
     const auto& nb = b.bvh.nodes();
     if (na.empty() || nb.empty()) return pairs;
@@ -228,9 +235,10 @@ struct PairDetector::Impl {
         std::span<const BvhNode>(na), std::span<const BvhNode>(nb), act_a, act_b,
         [](int, detail::TraversalCounters&) { return false; },
         [&](int x, int y, Pairs& out) { out.v.emplace_back(pa[na[x].first], pb[nb[y].first]); });
-    tbb::enumerable_thread_specific<Pairs> locals;
-    st.box_tests = detail::run_parallel(tr, {0, 0, false}, locals).box_tests;
-    for (const auto& l : locals)
+    for (auto& l : pair_locals)
+      l.v.clear();
+    st.box_tests = detail::run_parallel(tr, {0, 0, false}, pair_locals).box_tests;
+    for (const auto& l : pair_locals)
       pairs.insert(pairs.end(), l.v.begin(), l.v.end());
     return pairs;
   }
@@ -249,7 +257,7 @@ struct PairDetector::Impl {
 
     t = Clock::now();
     DetectStats st;
-    const auto pairs = traverse(st);
+    const auto& pairs = traverse(st);
     const double t_trav = seconds_since(t);
 
     t = Clock::now();
@@ -322,7 +330,7 @@ struct PairDetector::Impl {
     b.bvh.refit(b.x0, ro);
     a.bvh_call = b.bvh_call = 0;
     DetectStats st;
-    const auto pairs = traverse(st);
+    const auto& pairs = traverse(st);
     detail::FeatureContext ca = detail::proximity_context(a.topo, a.x0, h);
     detail::FeatureContext cb = detail::proximity_context(b.topo, b.x0, h);
     a.boxes.update(ca, a.step);
