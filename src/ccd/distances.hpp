@@ -22,4 +22,13 @@ namespace clothcd::detail {
 [[nodiscard]] double edge_edge_bound(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
                                      const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1);
 
+/// point_triangle_distance_if_within and edge_edge_distance_if_within without the input check,
+/// for the detectors' proximity queries (their positions are checked once per call).
+[[nodiscard]] double point_triangle_within(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
+                                           const Eigen::Vector3d& f1, const Eigen::Vector3d& f2,
+                                           double limit);
+[[nodiscard]] double edge_edge_within(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                                      const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1,
+                                      double limit);
+
 }  // namespace clothcd::detail

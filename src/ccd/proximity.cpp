@@ -156,6 +156,18 @@ EdgeEdgeProximity edge_edge_closest(const Eigen::Vector3d& ea0, const Eigen::Vec
   return best;
 }
 
+double point_triangle_within(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
+                             const Eigen::Vector3d& f1, const Eigen::Vector3d& f2, double limit) {
+  const double bound = point_triangle_bound(p, f0, f1, f2);
+  return bound > limit ? bound : point_triangle_closest(p, f0, f1, f2).distance;
+}
+
+double edge_edge_within(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
+                        const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1, double limit) {
+  const double bound = edge_edge_bound(ea0, ea1, eb0, eb1);
+  return bound > limit ? bound : edge_edge_closest(ea0, ea1, eb0, eb1).distance;
+}
+
 }  // namespace detail
 
 double point_triangle_distance_lower_bound(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
@@ -182,16 +194,14 @@ double point_triangle_distance_if_within(const Eigen::Vector3d& p, const Eigen::
                                          const Eigen::Vector3d& f1, const Eigen::Vector3d& f2,
                                          double limit) {
   require_finite({&p, &f0, &f1, &f2}, "point_triangle_distance_if_within");
-  const double bound = detail::point_triangle_bound(p, f0, f1, f2);
-  return bound > limit ? bound : detail::point_triangle_closest(p, f0, f1, f2).distance;
+  return detail::point_triangle_within(p, f0, f1, f2, limit);
 }
 
 double edge_edge_distance_if_within(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
                                     const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1,
                                     double limit) {
   require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_distance_if_within");
-  const double bound = detail::edge_edge_bound(ea0, ea1, eb0, eb1);
-  return bound > limit ? bound : detail::edge_edge_closest(ea0, ea1, eb0, eb1).distance;
+  return detail::edge_edge_within(ea0, ea1, eb0, eb1, limit);
 }
 
 double point_segment_parameter(const Eigen::Vector3d& p, const Eigen::Vector3d& a,

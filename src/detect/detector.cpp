@@ -16,6 +16,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "ccd/distances.hpp"
 #include "clearance.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/research/names.hpp"
@@ -749,11 +750,11 @@ struct SelfDetector::Impl {
     };
     tbb::enumerable_thread_specific<Buffer> locals;
     auto kvf = [&](int v, int f, const Face& t, Buffer& out) {
-      const double d = point_triangle_distance_if_within(v0[v], v0[t[0]], v0[t[1]], v0[t[2]], h);
+      const double d = detail::point_triangle_within(v0[v], v0[t[0]], v0[t[1]], v0[t[2]], h);
       if (d <= h) out.vf.push_back({v, f, d});
     };
     auto kee = [&](int a, int b, const Edge& ea, const Edge& eb, Buffer& out) {
-      const double d = edge_edge_distance_if_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
+      const double d = detail::edge_edge_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
       if (d <= h) out.ee.push_back({a, b, d});
     };
     // A piece at a time: the box test, the whole triangles' bound of the pairs past it at once

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <string_view>
 
+#include "ccd/distances.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/oracle.hpp"
@@ -371,19 +372,19 @@ struct PairDetector::Impl {
                 [&](int v, int k) {
                   const Face& t = faces_b[k];
                   const double d =
-                      point_triangle_distance_if_within(xa[v], xb[t[0]], xb[t[1]], xb[t[2]], h);
+                      detail::point_triangle_within(xa[v], xb[t[0]], xb[t[1]], xb[t[2]], h);
                   if (d <= h) out.ab.push_back({v, k, d});
                 },
                 [&](int u, int k) {
                   const Face& t = faces_a[k];
                   const double d =
-                      point_triangle_distance_if_within(xb[u], xa[t[0]], xa[t[1]], xa[t[2]], h);
+                      detail::point_triangle_within(xb[u], xa[t[0]], xa[t[1]], xa[t[2]], h);
                   if (d <= h) out.ba.push_back({u, k, d});
                 },
                 [&](int x, int y) {
                   const Edge &p = edges_a[x], &q = edges_b[y];
                   const double d =
-                      edge_edge_distance_if_within(xa[p[0]], xa[p[1]], xb[q[0]], xb[q[1]], h);
+                      detail::edge_edge_within(xa[p[0]], xa[p[1]], xb[q[0]], xb[q[1]], h);
                   if (d <= h) out.ee.push_back({x, y, d});
                 });
           }
