@@ -4,12 +4,14 @@
 // operation is an IEEE one (+, -, *, /, sqrt), an ordered comparison or a select, in a fixed
 // order, and every including source is compiled without floating-point contraction: a lane of a
 // batch then computes exactly what the scalar code computes for that pair, bit for bit, whatever
-// the input (NaN and infinity included). The orders are Eigen's for Vector3d (dot and squared
-// norm left to right, the usual cross product), and min / max select as std::min / std::max do.
+// the input (NaN and infinity included). The orders are Eigen's for Vector3d (lanes.hpp), and
+// min / max select as std::min / std::max do.
 // Each includer defines FACE_BOUNDS_NAMESPACE, so that code built for different instruction sets
 // never shares an inline symbol.
 
 #include <cmath>
+
+#include "ccd/lanes.hpp"
 
 namespace clothcd::detail {
 namespace FACE_BOUNDS_NAMESPACE {
@@ -19,22 +21,13 @@ inline double select(bool m, double a, double b) {
   return m ? a : b;
 }
 
+// The 3-vector of lanes and its operations (lanes.hpp).
 template <class T>
-struct P3 {
-  T x, y, z;
-};
-template <class T>
-P3<T> sub(const P3<T>& p, const P3<T>& q) {
-  return {p.x - q.x, p.y - q.y, p.z - q.z};
-}
-template <class T>
-T dot(const P3<T>& p, const P3<T>& q) {
-  return p.x * q.x + p.y * q.y + p.z * q.z;
-}
-template <class T>
-P3<T> cross(const P3<T>& p, const P3<T>& q) {
-  return {p.y * q.z - p.z * q.y, p.z * q.x - p.x * q.z, p.x * q.y - p.y * q.x};
-}
+using P3 = ccd_detail::lanes::Vec3<T>;
+using ccd_detail::lanes::cross;
+using ccd_detail::lanes::dot;
+using ccd_detail::lanes::sub;
+
 template <class T>
 T min_of(const T& a, const T& b) {  // std::min(a, b)
   return select(b < a, b, a);

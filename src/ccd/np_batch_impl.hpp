@@ -11,30 +11,18 @@
 #include <limits>
 
 #include "ccd/fast_path.hpp"
+#include "ccd/lanes.hpp"
 #include "ccd/motion.hpp"
 #include "ccd/np_batch.hpp"
 
 namespace clothcd::ccd_detail {
 namespace NP_BATCH_NAMESPACE {
 
-// A 3-vector of lanes and the vector operations both routines share, each in the scalar code's
-// operation order (no FMA contraction in these files).
-template <class B>
-struct Vec3 {
-  B x, y, z;
-};
-template <class B>
-Vec3<B> sub(const Vec3<B>& p, const Vec3<B>& q) {
-  return {p.x - q.x, p.y - q.y, p.z - q.z};
-}
-template <class B>
-Vec3<B> cross(const Vec3<B>& p, const Vec3<B>& q) {
-  return {p.y * q.z - p.z * q.y, p.z * q.x - p.x * q.z, p.x * q.y - p.y * q.x};
-}
-template <class B>
-B dot(const Vec3<B>& p, const Vec3<B>& q) {
-  return p.x * q.x + p.y * q.y + p.z * q.z;
-}
+// The 3-vector of lanes and the vector operations both routines share (lanes.hpp).
+using lanes::cross;
+using lanes::dot;
+using lanes::sub;
+using lanes::Vec3;
 template <class B>
 B max_abs(const Vec3<B>& p) {
   return xsimd::max(xsimd::max(xsimd::abs(p.x), xsimd::abs(p.y)), xsimd::abs(p.z));
