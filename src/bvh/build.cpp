@@ -287,6 +287,9 @@ void Bvh::build_tree(const Topology& topology, std::span<const Eigen::Vector3d> 
   }
   cones_.resize(nodes_.size());
   faces_ = topology.faces();
+  prim_faces_.resize(prim_ids_.size());
+  for (std::size_t i = 0; i < prim_ids_.size(); ++i)
+    prim_faces_[i] = faces_[prim_ids_[i]];
   num_vertices_ = topology.num_vertices();
 }
 

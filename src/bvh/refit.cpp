@@ -170,7 +170,7 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
                                   v_t0, v_t1);
   };
   auto leaf = [&](BvhNode& n, int i) {
-    const Face& t = faces[prim_ids_[n.first]];
+    const Face& t = prim_faces_[n.first];
     const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
     const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
     set_box(n, {&a0, &b0, &c0, &a1, &b1, &c1});
@@ -198,9 +198,8 @@ void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options)
   forget_changes();
   const double margin = 0.5 * options.thickness;
   const bool optimal = options.cones && options.optimal_cones;
-  const auto& faces = faces_;
   auto leaf = [&](BvhNode& n, int i) {
-    const Face& t = faces[prim_ids_[n.first]];
+    const Face& t = prim_faces_[n.first];
     const Eigen::Vector3d &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
     set_box(n, {&a, &b, &c});
     inflate(n.lo, n.hi, margin);

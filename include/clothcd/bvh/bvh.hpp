@@ -178,6 +178,9 @@ class Bvh {
   int num_vertices_ = 0;
   std::vector<BvhNode> nodes_;
   std::vector<int> prim_ids_;
+  // faces_[prim_ids_[i]] for each prim position i: a leaf's corners without the indirection
+  // (the refits' leaf loop waits on memory).
+  std::vector<Face> prim_faces_;
   std::vector<int> leaf_of_face_;
   std::vector<int> parent_;  // -1 for the root
   std::vector<int> level_offsets_;
