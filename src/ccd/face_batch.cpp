@@ -41,23 +41,6 @@ void triangle_bound_batch_scalar(const StaticFacePairBatch& b, double* bound) {
   }
 }
 
-// Runs body[isa] (0 scalar, 1 SSE2, 2 AVX2, 3 AVX-512F; -1: the widest the processor has) on
-// `args`; false, running nothing, where the processor or the build lacks it.
-template <class Fn, class... Args>
-bool run_on(int isa, const Fn (&body)[4], Args&&... args) {
-#if CLOTHCD_NP_BATCH_X86
-  if (isa < 0) isa = ccd_detail::has_avx512() ? 3 : (ccd_detail::has_avx2() ? 2 : 1);
-  if ((isa == 2 && !ccd_detail::has_avx2()) || (isa == 3 && !ccd_detail::has_avx512())) {
-    return false;
-  }
-#else
-  if (isa < 0) isa = 0;
-#endif
-  if (isa > 3 || body[isa] == nullptr) return false;
-  body[isa](args...);
-  return true;
-}
-
 #if CLOTHCD_NP_BATCH_X86
 constexpr void (*const kFilter[4])(const FacePairBatch&, double, bool*, double*) = {
     triangles_filter_batch_scalar, triangles_filter_batch_sse2, triangles_filter_batch_avx2,
@@ -76,20 +59,20 @@ constexpr void (*const kBound[4])(const StaticFacePairBatch&, double*) = {
 
 void triangles_filter_batch(const FacePairBatch& b, double thickness, bool* culls,
                             double* bound_t1) {
-  run_on(-1, kFilter, b, thickness, culls, bound_t1);
+  ccd_detail::run_on(-1, kFilter, b, thickness, culls, bound_t1);
 }
 
 bool triangles_filter_batch_with(int isa, const FacePairBatch& b, double thickness, bool* culls,
                                  double* bound_t1) {
-  return isa >= 0 && run_on(isa, kFilter, b, thickness, culls, bound_t1);
+  return isa >= 0 && ccd_detail::run_on(isa, kFilter, b, thickness, culls, bound_t1);
 }
 
 void triangle_bound_batch(const StaticFacePairBatch& b, double* bound) {
-  run_on(-1, kBound, b, bound);
+  ccd_detail::run_on(-1, kBound, b, bound);
 }
 
 bool triangle_bound_batch_with(int isa, const StaticFacePairBatch& b, double* bound) {
-  return isa >= 0 && run_on(isa, kBound, b, bound);
+  return isa >= 0 && ccd_detail::run_on(isa, kBound, b, bound);
 }
 
 }  // namespace clothcd::detail

@@ -10,19 +10,20 @@
 
 namespace clothcd::detail {
 
-/// Triangle pairs (a, b) at t0 and t1, gathered for triangles_filter_batch: coordinate c (0..2)
-/// of point p of pair i is x[3 * p + c][i], with p = 0..2 the corners of a at t0, 3..5 of a at
-/// t1, 6..8 of b at t0, 9..11 of b at t1.
-struct FacePairBatch {
+/// Up to kCapacity entries of `Triangles` triangles each, gathered coordinate by coordinate for the
+/// batched filters: coordinate c (0..2) of point p of entry i is x[3 * p + c][i], the points
+/// being the triangles' corners in the order pushed.
+template <int Triangles>
+struct TriangleBatch {
   static constexpr int kCapacity = 64;  // a multiple of every vector width
-  alignas(64) double x[36][kCapacity] = {};
+  alignas(64) double x[9 * Triangles][kCapacity] = {};
   int size = 0;
 
-  [[nodiscard]] bool full() const { return size == kCapacity; }
-  void push(const Triangle& a_t0, const Triangle& a_t1, const Triangle& b_t0,
-            const Triangle& b_t1) {
+  template <class... T>
+  void push(const T&... triangles) {
+    static_assert(sizeof...(T) == Triangles);
     int p = 0;
-    for (const Triangle* t : {&a_t0, &a_t1, &b_t0, &b_t1}) {
+    for (const Triangle* t : {&triangles...}) {
       for (const Eigen::Vector3d* q : *t) {
         for (int c = 0; c < 3; ++c)
           x[3 * p + c][size] = (*q)[c];
@@ -33,26 +34,11 @@ struct FacePairBatch {
   }
 };
 
-/// Triangle pairs (a, b) at one time, gathered for triangle_bound_batch: coordinate c of point p
-/// of pair i is x[3 * p + c][i], with p = 0..2 the corners of a, 3..5 those of b.
-struct StaticFacePairBatch {
-  static constexpr int kCapacity = 64;  // a multiple of every vector width
-  alignas(64) double x[18][kCapacity] = {};
-  int size = 0;
-
-  [[nodiscard]] bool full() const { return size == kCapacity; }
-  void push(const Triangle& a, const Triangle& b) {
-    int p = 0;
-    for (const Triangle* t : {&a, &b}) {
-      for (const Eigen::Vector3d* q : *t) {
-        for (int c = 0; c < 3; ++c)
-          x[3 * p + c][size] = (*q)[c];
-        ++p;
-      }
-    }
-    ++size;
-  }
-};
+/// Triangle pairs moving over a step, for triangles_filter_batch: a at t0, a at t1, b at t0, b at
+/// t1 (points 0..2, 3..5, 6..8, 9..11).
+using FacePairBatch = TriangleBatch<4>;
+/// Triangle pairs at one time, for triangle_bound_batch: a, then b (points 0..2, 3..5).
+using StaticFacePairBatch = TriangleBatch<2>;
 
 /// For each pair i < b.size: culls[i] = triangles_filter_culls(a_t0, a_t1, b_t0, b_t1, thickness,
 /// &bound_t1[i]). Uses the widest vector instructions the processor has (AVX-512, AVX2 or the

@@ -12,6 +12,13 @@
 
 namespace clothcd::detail::FACE_BOUNDS_NAMESPACE {
 
+// Point p of the entries i..i + B::size - 1 of a batch.
+template <class B, int Triangles>
+P3<B> load(const TriangleBatch<Triangles>& b, int p, int i) {
+  return {B::load_aligned(&b.x[3 * p][i]), B::load_aligned(&b.x[3 * p + 1][i]),
+          B::load_aligned(&b.x[3 * p + 2][i])};
+}
+
 template <class Arch>
 void triangles_filter_batch_impl(const FacePairBatch& b, double thickness, bool* culls,
                                  double* bound_t1) {
@@ -20,10 +27,7 @@ void triangles_filter_batch_impl(const FacePairBatch& b, double thickness, bool*
   static_assert(FacePairBatch::kCapacity % W == 0);
   const B th(thickness);
   for (int i = 0; i < b.size; i += W) {
-    const auto point = [&](int p) {
-      return P3<B>{B::load_aligned(&b.x[3 * p][i]), B::load_aligned(&b.x[3 * p + 1][i]),
-                   B::load_aligned(&b.x[3 * p + 2][i])};
-    };
+    const auto point = [&](int p) { return load<B>(b, p, i); };
     const Tri<B> a0 = {point(0), point(1), point(2)};
     const Tri<B> a1 = {point(3), point(4), point(5)};
     const Tri<B> b0 = {point(6), point(7), point(8)};
@@ -46,10 +50,7 @@ void triangle_bound_batch_impl(const StaticFacePairBatch& b, double* bound) {
   constexpr int W = static_cast<int>(B::size);
   static_assert(StaticFacePairBatch::kCapacity % W == 0);
   for (int i = 0; i < b.size; i += W) {
-    const auto point = [&](int p) {
-      return P3<B>{B::load_aligned(&b.x[3 * p][i]), B::load_aligned(&b.x[3 * p + 1][i]),
-                   B::load_aligned(&b.x[3 * p + 2][i])};
-    };
+    const auto point = [&](int p) { return load<B>(b, p, i); };
     const Tri<B> ta = {point(0), point(1), point(2)};
     const Tri<B> tb = {point(3), point(4), point(5)};
     alignas(64) double d[W];

@@ -1,6 +1,6 @@
 #pragma once
 // Internal: which of the vectorised bodies (np_batch.hpp, face_batch.hpp) this processor can run,
-// decided once per process.
+// decided once per process, and the call of the chosen one.
 
 namespace clothcd::ccd_detail {
 
@@ -16,5 +16,20 @@ inline bool has_avx512() {
   return yes;
 }
 #endif
+
+/// Runs body[isa] (0 scalar, 1 SSE2, 2 AVX2, 3 AVX-512F; -1: the widest the processor has) on
+/// `args`; false, running nothing, where the processor or the build lacks it (a null entry).
+template <class Fn, class... Args>
+bool run_on(int isa, const Fn (&body)[4], Args&&... args) {
+#if CLOTHCD_NP_BATCH_X86
+  if (isa < 0) isa = has_avx512() ? 3 : (has_avx2() ? 2 : 1);
+  if ((isa == 2 && !has_avx2()) || (isa == 3 && !has_avx512())) return false;
+#else
+  if (isa < 0) isa = 0;
+#endif
+  if (isa > 3 || body[isa] == nullptr) return false;
+  body[isa](args...);
+  return true;
+}
 
 }  // namespace clothcd::ccd_detail

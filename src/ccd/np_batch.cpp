@@ -73,81 +73,35 @@ void fast_path_misses_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdi
   }
 }
 
+#if CLOTHCD_NP_BATCH_X86
+constexpr void (*const kNp[4])(Kind, const NpBatch&, NpVerdict*) = {
+    np_filter_batch_scalar, np_filter_batch_sse2, np_filter_batch_avx2, np_filter_batch_avx512};
+constexpr void (*const kMiss[4])(Kind, const NpBatch&, const NpVerdict*, bool*) = {
+    fast_path_misses_scalar, fast_path_misses_sse2, fast_path_misses_avx2, fast_path_misses_avx512};
+#else
+constexpr void (*const kNp[4])(Kind, const NpBatch&, NpVerdict*) = {np_filter_batch_scalar, nullptr,
+                                                                    nullptr, nullptr};
+constexpr void (*const kMiss[4])(Kind, const NpBatch&, const NpVerdict*, bool*) = {
+    fast_path_misses_scalar, nullptr, nullptr, nullptr};
+#endif
+
 }  // namespace
 
 void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict) {
-#if CLOTHCD_NP_BATCH_X86
-  if (has_avx512()) {
-    np_filter_batch_avx512(kind, b, verdict);
-  } else if (has_avx2()) {
-    np_filter_batch_avx2(kind, b, verdict);
-  } else {
-    np_filter_batch_sse2(kind, b, verdict);
-  }
-#else
-  np_filter_batch_scalar(kind, b, verdict);
-#endif
+  run_on(-1, kNp, kind, b, verdict);
 }
 
 void fast_path_misses(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
-#if CLOTHCD_NP_BATCH_X86
-  if (has_avx512()) {
-    fast_path_misses_avx512(kind, b, verdict, miss);
-  } else if (has_avx2()) {
-    fast_path_misses_avx2(kind, b, verdict, miss);
-  } else {
-    fast_path_misses_sse2(kind, b, verdict, miss);
-  }
-#else
-  fast_path_misses_scalar(kind, b, verdict, miss);
-#endif
+  run_on(-1, kMiss, kind, b, verdict, miss);
 }
 
 bool fast_path_misses_with(int isa, Kind kind, const NpBatch& b, const NpVerdict* verdict,
                            bool* miss) {
-  switch (isa) {
-    case 0:
-      fast_path_misses_scalar(kind, b, verdict, miss);
-      return true;
-#if CLOTHCD_NP_BATCH_X86
-    case 1:
-      fast_path_misses_sse2(kind, b, verdict, miss);
-      return true;
-    case 2:
-      if (!has_avx2()) return false;
-      fast_path_misses_avx2(kind, b, verdict, miss);
-      return true;
-    case 3:
-      if (!has_avx512()) return false;
-      fast_path_misses_avx512(kind, b, verdict, miss);
-      return true;
-#endif
-    default:
-      return false;
-  }
+  return isa >= 0 && run_on(isa, kMiss, kind, b, verdict, miss);
 }
 
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict) {
-  switch (isa) {
-    case 0:
-      np_filter_batch_scalar(kind, b, verdict);
-      return true;
-#if CLOTHCD_NP_BATCH_X86
-    case 1:
-      np_filter_batch_sse2(kind, b, verdict);
-      return true;
-    case 2:
-      if (!has_avx2()) return false;
-      np_filter_batch_avx2(kind, b, verdict);
-      return true;
-    case 3:
-      if (!has_avx512()) return false;
-      np_filter_batch_avx512(kind, b, verdict);
-      return true;
-#endif
-    default:
-      return false;
-  }
+  return isa >= 0 && run_on(isa, kNp, kind, b, verdict);
 }
 
 }  // namespace clothcd::ccd_detail

@@ -295,30 +295,21 @@ struct SelfDetector::Impl {
       for (int line = 0; line < 3; ++line)
         detail::prefetch(block + 64 * line);
     };
-    // Pair i of the list, faces f and g.
+    // Without the distance filter, pair i of the list, faces f and g.
     const auto one = [&](std::size_t i, int f, int g, NarrowBuffer& out) {
+      if (near != nullptr) {
+        (*near)[i] =
+            !(detail::triangle_triangle_bound(detail::corners(v1, faces[f]),
+                                              detail::corners(v1, faces[g])) > opt.reuse_distance);
+      }
       // Widened leaf boxes: no feature pair of faces whose own boxes miss.
-      if (wide && !ctx.face_boxes[f].face_overlaps(ctx.face_boxes[g])) {
-        if (near != nullptr) {
-          (*near)[i] = !(detail::triangle_triangle_bound(detail::corners(v1, faces[f]),
-                                                         detail::corners(v1, faces[g])) >
-                         opt.reuse_distance);
-        }
-        return;
-      }
+      if (wide && !ctx.face_boxes[f].face_overlaps(ctx.face_boxes[g])) return;
       ++out.c.triangle_pairs;
-      double d1 = 0.0;
-      const bool apart = ctx.faces_apart(f, g, near != nullptr ? &d1 : nullptr);
-      if (near != nullptr) (*near)[i] = !(d1 > opt.reuse_distance);
-      if (apart) {
-        ++out.c.faces_apart;
-        return;
-      }
       triangle_pair(ctx, f, g, out, kvf, kee);
     };
     // With the distance filter, pairs [k0, k1) of a piece: the box test and the queueing of the
     // pairs past it, the whole-triangle filter on them at once, then their feature pairs, in
-    // list order (the results and counters are one's).
+    // list order.
     const auto batch = [&](std::size_t first, std::span<const detail::FacePair> piece,
                            std::size_t k0, std::size_t k1, NarrowBuffer& out) {
       detail::FacesApartBatch& fb = out.faces;

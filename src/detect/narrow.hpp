@@ -50,7 +50,7 @@ inline bool share_vertex(const Face& a, const Face& b) {
 struct FeatureCounters {
   std::uint64_t vf_tests = 0, ee_tests = 0, vf_np = 0, ee_np = 0;
   std::uint64_t triangle_pairs = 0;  // triangle pairs reaching the narrow phase
-  std::uint64_t faces_apart = 0;     // ... culled whole (FeatureContext::faces_apart)
+  std::uint64_t faces_apart = 0;     // ... culled whole (FacesApartBatch)
 
   /// Adds the feature test counters (not triangle_pairs, which callers count their own way).
   void add_to(DetectStats& s) const {
@@ -72,10 +72,11 @@ struct FeatureBatch {
   std::array<bool, kCapacity> miss;  // ccd_detail::fast_path_misses
 };
 
-/// Triangle pairs waiting for the whole-triangle distance filter (FeatureContext::faces_apart),
-/// which `run` applies to a batch at a time, vectorised (face_batch.hpp: the scalar verdicts and
-/// bounds bit for bit); one per thread. `slot[k]`: where the caller's k-th pair of a piece went
-/// (-1: not queued).
+/// Triangle pairs waiting for the whole-triangle distance filter (triangles_filter_culls: where
+/// it culls, it culls all 15 feature pairs of the two faces; a pair of layers resting on each
+/// other is mostly this), which `run` applies to a batch at a time, vectorised (face_batch.hpp:
+/// the scalar verdicts and bounds bit for bit); one per thread. `slot[k]`: where the caller's
+/// k-th pair of a piece went (-1: not queued).
 struct FacesApartBatch {
   static constexpr int kCapacity = FacePairBatch::kCapacity;
   FacePairBatch pairs;
@@ -197,23 +198,6 @@ struct FeatureContext {
   }
   [[nodiscard]] Box edge_box(int e) const {
     return eboxes.empty() ? compute_edge_box(e) : eboxes[e];
-  }
-
-  /// Whether the distance filter culls every feature pair of faces f and g at once (bounded as
-  /// whole triangles, triangles_filter_culls); false where that filter is not the one in use.
-  /// A triangle pair of two layers resting on each other is mostly this: one plane keeps the
-  /// other face on its side, and 15 feature bounds reduce to one.
-  /// `bound_t1`, when given, receives triangle_triangle_bound of the faces at t1 (computed here
-  /// even where the filter is not in use).
-  [[nodiscard]] bool faces_apart(int f, int g, double* bound_t1 = nullptr) const {
-    const Face& a = topo->faces()[f];
-    const Face& b = topo->faces()[g];
-    if (!distance_filter()) {
-      if (bound_t1 != nullptr) *bound_t1 = triangle_triangle_bound(corners(v1, a), corners(v1, b));
-      return false;
-    }
-    return triangles_filter_culls(corners(v0, a), corners(v1, a), corners(v0, b), corners(v1, b),
-                                  ccd.thickness, bound_t1);
   }
 
   /// Whether a vertex of the pair is linked to one of the other: such pairs are never tested.
