@@ -32,10 +32,12 @@ void np_filter_batch_scalar(Kind kind, const NpBatch& b, NpVerdict* verdict) {
 }
 
 // The kernel's own steps for one kept query (queries.cpp run, fast_path.cpp): whether every range
-// of fast_path_solve's search below `b` on [lo, hi] at `level` is dropped by kMissLevel.
+// of fast_path_solve's search below `b` on [lo, hi] at `level` is dropped by kMissLevel, counting
+// in `examined` the ranges the search examines (those not of one sign).
 bool dropped(const InsideData& data, const double (&b)[4], double e, double lo, double hi,
-             int level) {
+             int level, int& examined) {
   if (one_sign(b, e)) return true;
+  ++examined;
   if (level >= kFirstInsideLevel) {
     double u = 0, v = 0;
     const Inside in = inside_over(data, lo, hi, u, v);
@@ -45,7 +47,8 @@ bool dropped(const InsideData& data, const double (&b)[4], double e, double lo, 
   double l[4], r[4];
   halve(b, l, r);
   const double mid = (lo + hi) * 0.5;
-  return dropped(data, l, e, lo, mid, level + 1) && dropped(data, r, e, mid, hi, level + 1);
+  return dropped(data, l, e, lo, mid, level + 1, examined) &&
+         dropped(data, r, e, mid, hi, level + 1, examined);
 }
 
 bool fast_path_miss_scalar(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points) {
@@ -53,13 +56,15 @@ bool fast_path_miss_scalar(Kind kind, const std::array<const Eigen::Vector3d*, 8
   if (!(m.max_abs.maxCoeff() > 0)) return false;  // run() reports contact at t = 0
   const BernsteinCubic c = coplanarity_cubic(kind, m);
   if (np_culls(c)) return false;  // path NpCulled, not a miss
-  return dropped(inside_data(kind, m), c.k, subdivision_error(c), 0.0, 1.0, 0);
+  // Past its budget the kernel hands the rest of the step to the inclusion solver: not a miss.
+  int examined = 0;
+  return dropped(inside_data(kind, m), c.k, subdivision_error(c), 0.0, 1.0, 0, examined) &&
+         examined <= kFastPathBudget;
 }
 
 void fast_path_misses_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
-  // Every range the search examines by kMissLevel is within its budget, none at its last level.
+  // No range the search examines by kMissLevel is at its last level (the inclusion solver's).
   static_assert(kFirstInsideLevel <= kMissLevel && kMissLevel < kFastPathMaxLevel);
-  static_assert((2 << kMissLevel) - 1 <= kFastPathBudget);
   for (int i = 0; i < b.size; ++i) {
     miss[i] = false;
     if (verdict[i] != NpVerdict::Kept) continue;

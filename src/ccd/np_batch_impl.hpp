@@ -6,6 +6,7 @@
 
 #include <xsimd/xsimd.hpp>
 
+#include <bit>
 #include <cfloat>
 #include <cstdint>
 #include <limits>
@@ -136,9 +137,10 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   // The kept queries only, W at a time (a partial group repeats its last query).
   int kept[NpBatch::kCapacity];
   int nk = 0;
-  for (int i = 0; i < b.size; ++i) {
+  for (int i = 0; i < b.size; ++i) {  // without a branch: the verdicts are unpredictable
     miss[i] = false;
-    if (verdict[i] == NpVerdict::Kept) kept[nk++] = i;
+    kept[nk] = i;
+    nk += verdict[i] == NpVerdict::Kept ? 1 : 0;
   }
   for (int s = 0; s < nk; s += W) {
     const int n = nk - s < W ? nk - s : W;
@@ -231,28 +233,36 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
     // [j, j + 1] / 2^level. The kernel visits every range whose parent it splits and drops it
     // where the cubic keeps one sign on it; from kFirstInsideLevel on it drops it where the
     // inside answer is No, reports a hit where it is Yes and the cubic changes sign, and splits it
-    // otherwise. A lane is a miss when no range is left open by kMissLevel: then the kernel's
-    // depth-first order visits the same ranges with the same answers (none a hit), at most
-    // 2^(kMissLevel + 1) - 1 of them, within its budget.
+    // otherwise. A lane is a miss when no range is left open by kMissLevel and the ranges it
+    // examined (not of one sign) number at most kFastPathBudget: then the kernel's depth-first
+    // order examines the same ranges with the same answers (none a hit) and never reaches its
+    // budget.
     constexpr int kSlots = 1 << kMissLevel;
+    static_assert(kSlots <= 64);
     B coef[2][kSlots][4];  // this level's ranges and the next one's, alternately
-    Mask open[2][kSlots];
+    Mask open[2][kSlots];  // valid where the level's `slots` bit is set
     int now = 0;
     Mask missed = !np_culled;
+    const B one(1.0), zero(0.0);
+    B examined(0.0);  // per lane, as fast_path_solve's `visited`
     for (int c = 0; c < 4; ++c)
       coef[0][0][c] = k[c];
     open[0][0] = missed && !one_sign(k, e);
-    for (int level = 0; level <= kMissLevel; ++level) {
+    // The ranges open in some lane, one bit each: only those are visited.
+    std::uint64_t slots = xsimd::any(open[0][0]) ? 1u : 0u;
+    for (int level = 0; level <= kMissLevel && slots != 0; ++level) {
       const int count = 1 << level;
       B(&cur)[kSlots][4] = coef[now];
       B(&nxt)[kSlots][4] = coef[1 - now];
       const Mask* cur_open = open[now];
       Mask* nxt_open = open[1 - now];
       Mask any_open(false);
-      for (int j = 0; j < count; ++j) {
+      std::uint64_t next_slots = 0;
+      for (std::uint64_t bits = slots; bits != 0; bits &= bits - 1) {
+        const int j = std::countr_zero(bits);
         const Mask need = missed && cur_open[j];
-        if (level < kMissLevel) nxt_open[2 * j] = nxt_open[2 * j + 1] = Mask(false);
         if (xsimd::none(need)) continue;
+        examined = examined + xsimd::select(need, one, zero);
         Mask split = need;
         if (level >= kFirstInsideLevel) {
           const double width = 1.0 / count;
@@ -272,11 +282,15 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
         nxt_open[2 * j] = split && !one_sign(nxt[2 * j], e);
         nxt_open[2 * j + 1] = split && !one_sign(nxt[2 * j + 1], e);
         any_open = any_open || nxt_open[2 * j] || nxt_open[2 * j + 1];
+        next_slots |= std::uint64_t(xsimd::any(nxt_open[2 * j])) << (2 * j);
+        next_slots |= std::uint64_t(xsimd::any(nxt_open[2 * j + 1])) << (2 * j + 1);
       }
       // Done where every lane still missing has no range left (the others are settled).
       if (level == kMissLevel || xsimd::none(missed && any_open)) break;
+      slots = next_slots;
       now = 1 - now;
     }
+    missed = missed && (examined <= B(double(kFastPathBudget)));
     bool m[W];
     missed.store_unaligned(m);
     for (int l = 0; l < n; ++l)

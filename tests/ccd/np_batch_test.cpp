@@ -226,6 +226,49 @@ TEST(FastPathMisses, MatchTheKernelOnRandomQueries) {
   EXPECT_GT(kept - missed, 100);
 }
 
+// Exactly coplanar motion (every point in z = 0: the cubic is zero, never of one sign): a vertex
+// or an edge sliding along a long slanted edge, outside it by 2^-3..2^-9 of its travel. The
+// inside test's intervals tell them apart only on short ranges, so the search examines every
+// range down to that depth, often more ranges than the kernel's budget.
+Points sliding_coplanar(Gen& g, Kind kind) {
+  const double angle = g.uniform(0.2, 1.4);
+  const V u(std::cos(angle), std::sin(angle), 0.0), n(-u.y(), u.x(), 0.0);
+  const double gap = std::ldexp(1.0, -g.integer(3, 9));
+  const double x0 = g.uniform(-0.6, -0.4), x1 = g.uniform(0.4, 0.6);
+  Points p;
+  if (kind == Kind::VertexFace) {  // p[0] the vertex below edge p[1]p[2] of the static triangle
+    p[0] = x0 * u - gap * n;
+    p[4] = x1 * u - gap * n;
+    p[1] = p[5] = -0.8 * u;
+    p[2] = p[6] = 0.8 * u;
+    p[3] = p[7] = 0.8 * n;
+  } else {  // edge p[0]p[1] across the line of static edge p[2]p[3], beyond it by the gap
+    p[0] = x0 * u + gap * n;
+    p[1] = x0 * u + (gap + 0.3) * n;
+    p[4] = x1 * u + gap * n;
+    p[5] = x1 * u + (gap + 0.3) * n;
+    p[2] = p[6] = -0.8 * u;
+    p[3] = p[7] = 0.8 * u;
+  }
+  return p;
+}
+
+TEST(FastPathMisses, MatchTheKernelOnSlidingCoplanarQueries) {
+  int kept = 0, missed = 0;
+  for (std::uint64_t seed = 400; seed < 404; ++seed) {
+    Gen g(seed);
+    for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
+      std::vector<Points> qs;
+      for (int i = 0; i < NpBatch::kCapacity; ++i)
+        qs.push_back(sliding_coplanar(g, kind));
+      for (const bool m : check_misses(kind, qs, kept))
+        missed += m;
+    }
+  }
+  EXPECT_GT(missed, 10);
+  EXPECT_GT(kept - missed, 10);
+}
+
 TEST(FastPathMisses, MissNoQueryInContact) {
   int kept = 0, missed = 0;
   for (std::uint64_t seed = 300; seed < 306; ++seed) {
