@@ -27,12 +27,13 @@ struct Node {
   int level;
 };
 
-// Lower bound on the first root of the cubic on the node's range: the start of the earliest
-// range of width 2^-target on which the cubic is not provably of one sign.
-double first_root_bound(const Node& root, double e, int target) {
+}  // namespace
+
+double first_root_bound(const double (&b)[4], double lo, double hi, int level, double e,
+                        int target) {
   Node stack[kMaxRefine + 2];
   int n = 0;
-  stack[n++] = root;
+  stack[n++] = Node{{b[0], b[1], b[2], b[3]}, lo, hi, level};
   while (n > 0) {
     const Node nd = stack[--n];
     if (one_sign(nd.b, e)) continue;
@@ -43,23 +44,22 @@ double first_root_bound(const Node& root, double e, int target) {
     stack[n++] = r;
     stack[n++] = l;
   }
-  // Unreachable when the bounds hold (the node has a certain sign change); stay conservative.
-  return root.lo;
+  // Unreachable when the bounds hold (the range has a certain sign change); stay conservative.
+  return lo;
 }
 
-}  // namespace
+int toi_target_level(double toi_tolerance) {
+  if (!(toi_tolerance > 0)) return kMaxRefine;
+  int exp = 0;
+  std::frexp(toi_tolerance, &exp);  // 2^(exp-1) <= tol < 2^exp
+  return std::clamp(1 - exp, 0, kMaxRefine);
+}
 
 FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
                             const InclusionParams& p) {
   const double e = subdivision_error(c);
   const InsideData data = inside_data(kind, m);
-  // Depth at which the certified time of impact is within toi_tolerance of the root range.
-  int target = kMaxRefine;
-  if (p.toi_tolerance > 0) {
-    int exp = 0;
-    std::frexp(p.toi_tolerance, &exp);  // 2^(exp-1) <= tol < 2^exp
-    target = std::clamp(1 - exp, 0, kMaxRefine);
-  }
+  const int target = toi_target_level(p.toi_tolerance);
   FastOutcome out;
   InclusionParams q = p;
   auto include = [&](double lo, double hi) {
@@ -106,7 +106,7 @@ FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
       // A root with the contact point strictly inside: a contact in this range, and none before.
       out.hit = true;
       out.certified = true;
-      out.toi = first_root_bound(nd, e, std::max(target, nd.level));
+      out.toi = first_root_bound(nd.b, nd.lo, nd.hi, nd.level, e, std::max(target, nd.level));
       out.u = u;
       out.v = v;
       return out;

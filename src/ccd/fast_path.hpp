@@ -21,11 +21,21 @@ struct FastOutcome {
 
 /// The search examines a range with the inside test from this depth on (shallower ranges are
 /// only halved), and at most kFastPathBudget ranges per query (fast_path.cpp says why);
-/// fast_path_misses (np_batch.hpp) repeats the search down to a fixed depth.
+/// fast_path_settle (np_batch.hpp) repeats the search down to a fixed depth.
 inline constexpr int kFirstInsideLevel = 2;
 inline constexpr int kFastPathBudget = 48;
 /// Ranges still undecided at this depth go to the inclusion solver.
 inline constexpr int kFastPathMaxLevel = 10;
+
+/// The depth of range whose start the search reports as a certified hit's time of impact: its
+/// width is at most toi_tolerance (kMaxRefine = 40 for a tolerance of 0).
+int toi_target_level(double toi_tolerance);
+
+/// A certified hit's time of impact: the start of the earliest range of depth `target` (at least
+/// `level`) inside [lo, hi] (a range of depth `level` with Bernstein coefficients b and error e,
+/// on which the cubic provably changes sign) on which the cubic is not provably of one sign.
+double first_root_bound(const double (&b)[4], double lo, double hi, int level, double e,
+                        int target);
 
 /// `p` gives the inclusion solver's settings (its time range is ignored); `c` is the query's
 /// coplanarity cubic (not NP-culled).

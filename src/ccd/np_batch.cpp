@@ -1,5 +1,7 @@
 #include "ccd/np_batch.hpp"
 
+#include <algorithm>
+
 #include "ccd/certify.hpp"
 #include "ccd/fast_path.hpp"
 #include "ccd/isa.hpp"
@@ -11,10 +13,13 @@ namespace clothcd::ccd_detail {
 #if CLOTHCD_NP_BATCH_X86
 void np_filter_batch_sse2(Kind kind, const NpBatch& b, NpVerdict* verdict);
 void np_filter_batch_avx2(Kind kind, const NpBatch& b, NpVerdict* verdict);
-void fast_path_misses_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
-void fast_path_misses_avx2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
+void fast_path_settle_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
+                           FastSettled* settled, double* toi);
+void fast_path_settle_avx2(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
+                           FastSettled* settled, double* toi);
 void np_filter_batch_avx512(Kind kind, const NpBatch& b, NpVerdict* verdict);
-void fast_path_misses_avx512(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
+void fast_path_settle_avx512(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
+                             FastSettled* settled, double* toi);
 #endif
 
 namespace {
@@ -31,42 +36,55 @@ void np_filter_batch_scalar(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   }
 }
 
-// The kernel's own steps for one kept query (queries.cpp run, fast_path.cpp): whether every range
-// of fast_path_solve's search below `b` on [lo, hi] at `level` is dropped by kMissLevel, counting
-// in `examined` the ranges the search examines (those not of one sign).
-bool dropped(const InsideData& data, const double (&b)[4], double e, double lo, double hi,
-             int level, int& examined) {
-  if (one_sign(b, e)) return true;
-  ++examined;
-  if (level >= kFirstInsideLevel) {
-    double u = 0, v = 0;
-    const Inside in = inside_over(data, lo, hi, u, v);
-    if (in == Inside::No) return true;
-    if (level == kMissLevel || (in == Inside::Yes && sign_change(b, e))) return false;
-  }
-  double l[4], r[4];
-  halve(b, l, r);
-  const double mid = (lo + hi) * 0.5;
-  return dropped(data, l, e, lo, mid, level + 1, examined) &&
-         dropped(data, r, e, mid, hi, level + 1, examined);
-}
-
-bool fast_path_miss_scalar(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points) {
+// fast_path_solve's search for one kept query, step for step, stopping where it would split a
+// range below kSettleLevel (Run) or pass its budget (Run).
+FastSettled settle_scalar(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
+                          int target, double& toi) {
   const Motion m = make_motion(points);
-  if (!(m.max_abs.maxCoeff() > 0)) return false;  // run() reports contact at t = 0
+  if (!(m.max_abs.maxCoeff() > 0)) return FastSettled::Run;  // run() reports contact at t = 0
   const BernsteinCubic c = coplanarity_cubic(kind, m);
-  if (np_culls(c)) return false;  // path NpCulled, not a miss
-  // Past its budget the kernel hands the rest of the step to the inclusion solver: not a miss.
-  int examined = 0;
-  return dropped(inside_data(kind, m), c.k, subdivision_error(c), 0.0, 1.0, 0, examined) &&
-         examined <= kFastPathBudget;
+  if (np_culls(c)) return FastSettled::Run;  // path NpCulled
+  const double e = subdivision_error(c);
+  const InsideData data = inside_data(kind, m);
+  struct Node {
+    double b[4];
+    double lo, hi;
+    int level;
+  };
+  Node stack[kSettleLevel + 2];
+  int n = 0;
+  stack[n++] = Node{{c.k[0], c.k[1], c.k[2], c.k[3]}, 0.0, 1.0, 0};
+  int visited = 0;
+  while (n > 0) {
+    const Node nd = stack[--n];
+    if (one_sign(nd.b, e)) continue;
+    if (++visited > kFastPathBudget) return FastSettled::Run;
+    if (nd.level >= kFirstInsideLevel) {
+      double u = 0, v = 0;
+      const Inside in = inside_over(data, nd.lo, nd.hi, u, v);
+      if (in == Inside::No) continue;
+      if (in == Inside::Yes && sign_change(nd.b, e)) {
+        toi = first_root_bound(nd.b, nd.lo, nd.hi, nd.level, e, std::max(target, nd.level));
+        return FastSettled::Hit;
+      }
+      if (nd.level >= kSettleLevel) return FastSettled::Run;
+    }
+    const double mid = (nd.lo + nd.hi) * 0.5;
+    Node l{{}, nd.lo, mid, nd.level + 1}, r{{}, mid, nd.hi, nd.level + 1};
+    halve(nd.b, l.b, r.b);
+    stack[n++] = r;
+    stack[n++] = l;
+  }
+  return FastSettled::Miss;
 }
 
-void fast_path_misses_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
-  // No range the search examines by kMissLevel is at its last level (the inclusion solver's).
-  static_assert(kFirstInsideLevel <= kMissLevel && kMissLevel < kFastPathMaxLevel);
+void settle_batch_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
+                         FastSettled* settled, double* toi) {
+  // No range the search examines by kSettleLevel is at its last level (the inclusion solver's).
+  static_assert(kFirstInsideLevel <= kSettleLevel && kSettleLevel < kFastPathMaxLevel);
   for (int i = 0; i < b.size; ++i) {
-    miss[i] = false;
+    settled[i] = FastSettled::Run;
+    toi[i] = 1.0;
     if (verdict[i] != NpVerdict::Kept) continue;
     Eigen::Vector3d p[8];
     std::array<const Eigen::Vector3d*, 8> points;
@@ -74,20 +92,21 @@ void fast_path_misses_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdi
       p[k] = {b.x[3 * k][i], b.x[3 * k + 1][i], b.x[3 * k + 2][i]};
       points[k] = &p[k];
     }
-    miss[i] = fast_path_miss_scalar(kind, points);
+    settled[i] = settle_scalar(kind, points, target, toi[i]);
   }
 }
 
 #if CLOTHCD_NP_BATCH_X86
 constexpr void (*const kNp[4])(Kind, const NpBatch&, NpVerdict*) = {
     np_filter_batch_scalar, np_filter_batch_sse2, np_filter_batch_avx2, np_filter_batch_avx512};
-constexpr void (*const kMiss[4])(Kind, const NpBatch&, const NpVerdict*, bool*) = {
-    fast_path_misses_scalar, fast_path_misses_sse2, fast_path_misses_avx2, fast_path_misses_avx512};
+constexpr void (*const kSettle[4])(Kind, const NpBatch&, const NpVerdict*, int, FastSettled*,
+                                   double*) = {settle_batch_scalar, fast_path_settle_sse2,
+                                               fast_path_settle_avx2, fast_path_settle_avx512};
 #else
 constexpr void (*const kNp[4])(Kind, const NpBatch&, NpVerdict*) = {np_filter_batch_scalar, nullptr,
                                                                     nullptr, nullptr};
-constexpr void (*const kMiss[4])(Kind, const NpBatch&, const NpVerdict*, bool*) = {
-    fast_path_misses_scalar, nullptr, nullptr, nullptr};
+constexpr void (*const kSettle[4])(Kind, const NpBatch&, const NpVerdict*, int, FastSettled*,
+                                   double*) = {settle_batch_scalar, nullptr, nullptr, nullptr};
 #endif
 
 }  // namespace
@@ -96,13 +115,15 @@ void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   run_on(-1, kNp, kind, b, verdict);
 }
 
-void fast_path_misses(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
-  run_on(-1, kMiss, kind, b, verdict, miss);
+void fast_path_settle(Kind kind, const NpBatch& b, const NpVerdict* verdict, double toi_tolerance,
+                      FastSettled* settled, double* toi) {
+  run_on(-1, kSettle, kind, b, verdict, toi_target_level(toi_tolerance), settled, toi);
 }
 
-bool fast_path_misses_with(int isa, Kind kind, const NpBatch& b, const NpVerdict* verdict,
-                           bool* miss) {
-  return isa >= 0 && run_on(isa, kMiss, kind, b, verdict, miss);
+bool fast_path_settle_with(int isa, Kind kind, const NpBatch& b, const NpVerdict* verdict,
+                           double toi_tolerance, FastSettled* settled, double* toi) {
+  return isa >= 0 &&
+         run_on(isa, kSettle, kind, b, verdict, toi_target_level(toi_tolerance), settled, toi);
 }
 
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict) {

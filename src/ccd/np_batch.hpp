@@ -39,28 +39,42 @@ void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict);
 /// lacks it.
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict);
 
-/// The depth (ranges of 2^-kMissLevel of the step) to which fast_path_misses follows the search.
-/// On cloth_ball 92 -> 93, of 2.23 M kept queries, depth 4 settles 1.99 M and depth 6 2.09 M
-/// (113,855 are hits); each query left over costs the scalar kernel's whole search.
-inline constexpr int kMissLevel = 6;
+/// The depth (ranges of 2^-kSettleLevel of the step) to which fast_path_settle follows the
+/// search. On cloth_ball 92 -> 93, of 2.23 M kept queries, depth 4 settles 1.99 M misses and
+/// depth 6 2.09 M; each query left over costs the scalar kernel's whole search.
+inline constexpr int kSettleLevel = 6;
 
-/// For each query i < b.size whose NP verdict[i] is Kept: miss[i] = true where the kernel at
-/// zero thickness with the fast path (vertex_face_ccd_np_kept, edge_edge_ccd_np_kept) reports no
-/// contact, with path FastPath, by depth kMissLevel of its search: the scaled cubic is not
-/// NP-culled, every range the search examines by then is dropped, the cubic keeping one sign
-/// on it or the contact point provably outside the features over it (inside_over's No), and
-/// those ranges number at most kFastPathBudget (past it the kernel calls the inclusion solver).
-/// miss[i] = false elsewhere: run the kernel.
+/// What fast_path_settle finds of a query: the zero-thickness kernel's own answer (fast path on,
+/// vertex_face_ccd_np_kept, edge_edge_ccd_np_kept), or Run where it would search deeper.
+enum class FastSettled : std::uint8_t {
+  Run,   ///< not settled: run the kernel
+  Miss,  ///< no contact (the kernel's path FastPath)
+  Hit,   ///< contact, first at the time given (the kernel's path Certified, the same toi)
+};
+
+/// For each query i < b.size whose NP verdict[i] is Kept, the kernel's depth-first search over
+/// time ranges (fast_path_solve) truncated at depth kSettleLevel: settled[i] = Miss where it
+/// drops every range it examines (the cubic keeping one sign on it, or the contact point
+/// provably outside the features over it: inside_over's No); Hit, with toi[i] the kernel's time
+/// of impact, where it certifies a range (inside_over's Yes and a sign change of the cubic)
+/// before reaching a range it would split below kSettleLevel; in both cases only when it
+/// examines at most kFastPathBudget ranges on the way (past it the kernel calls the inclusion
+/// solver). Run elsewhere, NP verdicts other than Kept included. `toi_tolerance` is the
+/// kernel's (CcdOptions::toi_tolerance).
 /// Each lane performs the kernel's own floating-point operations in its order (make_motion's
 /// scaling, coplanarity_cubic, np_culls, subdivision_error, halve, one_sign, inside_data,
-/// inside_over), so a miss is exactly the kernel's verdict.
-void fast_path_misses(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss);
+/// inside_over, first_root_bound), so what it settles is exactly the kernel's answer. The lanes
+/// follow the search level by level, all ranges of a level at once; the kernel's depth-first
+/// order visits the same ranges up to its answer: the earliest certified range, after every
+/// earlier range is dropped.
+void fast_path_settle(Kind kind, const NpBatch& b, const NpVerdict* verdict, double toi_tolerance,
+                      FastSettled* settled, double* toi);
 
-/// The same with a fixed instruction set, for tests: 0 scalar (the kernel's functions per
+/// The same with a fixed instruction set, for tests: 0 scalar (the kernel's truncated search per
 /// query), 1 SSE2, 2 AVX2, 3 AVX-512. Returns false (and does nothing) when the processor lacks
 /// it.
-bool fast_path_misses_with(int isa, Kind kind, const NpBatch& b, const NpVerdict* verdict,
-                           bool* miss);
+bool fast_path_settle_with(int isa, Kind kind, const NpBatch& b, const NpVerdict* verdict,
+                           double toi_tolerance, FastSettled* settled, double* toi);
 
 /// vertex_face_ccd and edge_edge_ccd for a query whose unscaled_np_filter verdict is known to be
 /// Kept: the same result, without running that filter again.

@@ -1,4 +1,4 @@
-// np_filter_batch and fast_path_misses with AVX2 (compiled with -mavx2, without FMA; called only
+// np_filter_batch and fast_path_settle with AVX2 (compiled with -mavx2, without FMA; called only
 // where the processor has AVX2).
 #define NP_BATCH_NAMESPACE avx2_impl
 #include "ccd/np_batch_impl.hpp"
@@ -9,8 +9,9 @@ void np_filter_batch_avx2(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   avx2_impl::np_filter_batch_impl<xsimd::avx2>(kind, b, verdict);
 }
 
-void fast_path_misses_avx2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
-  avx2_impl::fast_path_misses_impl<xsimd::avx2>(kind, b, verdict, miss);
+void fast_path_settle_avx2(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
+                           FastSettled* settled, double* toi) {
+  avx2_impl::fast_path_settle_impl<xsimd::avx2>(kind, b, verdict, target, settled, toi);
 }
 
 }  // namespace clothcd::ccd_detail

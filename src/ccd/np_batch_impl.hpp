@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the bodies of np_filter_batch and fast_path_misses for one xsimd architecture,
+// Internal: the bodies of np_filter_batch and fast_path_settle for one xsimd architecture,
 // included by one source file per instruction set (each compiled with its own target flags and
 // -ffp-contract=off). Every lane repeats the scalar code (cubic_of and unscaled_np_filter in
 // cubic.cpp; the kernel's fast path) operation for operation.
@@ -96,11 +96,12 @@ void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   }
 }
 
-// fast_path_misses (np_batch.hpp): lane by lane, the kernel's operations on a query the NP filter
-// kept, from make_motion's scaling to the inside tests of the search down to kMissLevel, each as
-// the scalar code performs it (the sources named at each step).
+// fast_path_settle (np_batch.hpp): lane by lane, the kernel's operations on a query the NP filter
+// kept, from make_motion's scaling to the inside tests of the search down to kSettleLevel, each
+// as the scalar code performs it (the sources named at each step). `target`: toi_target_level.
 template <class Arch>
-void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
+void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
+                           FastSettled* settled, double* toi) {
   using B = xsimd::batch<double, Arch>;
   using Mask = xsimd::batch_bool<double, Arch>;
   constexpr int W = static_cast<int>(B::size);
@@ -138,7 +139,8 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   int kept[NpBatch::kCapacity];
   int nk = 0;
   for (int i = 0; i < b.size; ++i) {  // without a branch: the verdicts are unpredictable
-    miss[i] = false;
+    settled[i] = FastSettled::Run;
+    toi[i] = 1.0;
     kept[nk] = i;
     nk += verdict[i] == NpVerdict::Kept ? 1 : 0;
   }
@@ -229,72 +231,133 @@ void fast_path_misses_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
       add(idot(nn, icross(at(4), x0)));
       return v;
     };
-    // fast_path_solve's search, level by level to kMissLevel: range j of a level spans
-    // [j, j + 1] / 2^level. The kernel visits every range whose parent it splits and drops it
-    // where the cubic keeps one sign on it; from kFirstInsideLevel on it drops it where the
-    // inside answer is No, reports a hit where it is Yes and the cubic changes sign, and splits it
-    // otherwise. A lane is a miss when no range is left open by kMissLevel and the ranges it
-    // examined (not of one sign) number at most kFastPathBudget: then the kernel's depth-first
-    // order examines the same ranges with the same answers (none a hit) and never reaches its
-    // budget.
-    constexpr int kSlots = 1 << kMissLevel;
+    // fast_path_solve's search, level by level: range j of a level spans [j, j + 1] / 2^level.
+    // The kernel examines every range whose parent it splits unless the cubic keeps one sign on
+    // it; from kFirstInsideLevel on it drops the range where the inside answer is No, certifies
+    // a hit where it is Yes and the cubic changes sign, and splits it otherwise (below
+    // kSettleLevel; deeper ranges are left to it: "open"). Its depth-first order reaches a range
+    // after every earlier one and the ranges containing it. So a lane is a miss when nothing is
+    // certified or open and it examined at most kFastPathBudget ranges, and a hit in its
+    // earliest certified range H when no open range starts before H and at most
+    // kFastPathBudget examined ranges start at or before H (the earlier ranges, the ranges
+    // containing H, and H). Ranges starting at or after a lane's earliest certified or open
+    // range cannot change its answer and are not followed.
+    constexpr int kSlots = 1 << kSettleLevel;
     static_assert(kSlots <= 64);
+    constexpr int kLevels = kSettleLevel + 1;
     B coef[2][kSlots][4];  // this level's ranges and the next one's, alternately
     Mask open[2][kSlots];  // valid where the level's `slots` bit is set
     int now = 0;
-    Mask missed = !np_culled;
+    const Mask active = !np_culled;
+    const B inf(std::numeric_limits<double>::infinity());
+    B hit_lo = inf, open_lo = inf;  // start of the earliest certified, open range
+    // The ranges examined: how many per lane, in which lanes (seen, valid where the level's
+    // seen_slots bit is set); and per lane the earliest certified range's level, index and
+    // coefficients.
     const B one(1.0), zero(0.0);
-    B examined(0.0);  // per lane, as fast_path_solve's `visited`
+    B examined(0.0);
+    Mask seen[kLevels][kSlots];
+    std::uint64_t seen_slots[kLevels] = {};
+    int hit_level[W] = {}, hit_j[W] = {};
+    double hit_b[W][4] = {};
     for (int c = 0; c < 4; ++c)
       coef[0][0][c] = k[c];
-    open[0][0] = missed && !one_sign(k, e);
+    open[0][0] = active && !one_sign(k, e);
     // The ranges open in some lane, one bit each: only those are visited.
     std::uint64_t slots = xsimd::any(open[0][0]) ? 1u : 0u;
-    for (int level = 0; level <= kMissLevel && slots != 0; ++level) {
+    for (int level = 0; level <= kSettleLevel && slots != 0; ++level) {
       const int count = 1 << level;
+      const double width = 1.0 / count;
       B(&cur)[kSlots][4] = coef[now];
       B(&nxt)[kSlots][4] = coef[1 - now];
       const Mask* cur_open = open[now];
       Mask* nxt_open = open[1 - now];
-      Mask any_open(false);
       std::uint64_t next_slots = 0;
       for (std::uint64_t bits = slots; bits != 0; bits &= bits - 1) {
         const int j = std::countr_zero(bits);
-        const Mask need = missed && cur_open[j];
+        const double lo_t = width * j;
+        const Mask need = cur_open[j] && (B(lo_t) < xsimd::min(hit_lo, open_lo));
         if (xsimd::none(need)) continue;
         examined = examined + xsimd::select(need, one, zero);
+        seen[level][j] = need;
+        seen_slots[level] |= std::uint64_t(1) << j;
         Mask split = need;
         if (level >= kFirstInsideLevel) {
-          const double width = 1.0 / count;
-          const Verdict in = inside(width * j, width * (j + 1), need);
+          const Verdict in = inside(lo_t, width * (j + 1), need);
           const Mask left = need && !in.no;
-          if (level == kMissLevel) {
-            missed = missed && !left;
-            continue;
-          }
           const Mask change =
               ((cur[j][0] > e) && (cur[j][3] < -e)) || ((cur[j][0] < -e) && (cur[j][3] > e));
-          missed = missed && !(left && in.yes && change);
-          split = left && missed;
+          const Mask hit = left && in.yes && change;
+          if (xsimd::any(hit)) {
+            // The earliest so far in these lanes: ranges are visited in time order per level,
+            // and need keeps only ranges before the lane's earliest certified one.
+            hit_lo = xsimd::select(hit, B(lo_t), hit_lo);
+            bool hb[W];
+            hit.store_unaligned(hb);
+            alignas(64) double cb[4][W];
+            for (int c = 0; c < 4; ++c)
+              cur[j][c].store_aligned(cb[c]);
+            for (int l = 0; l < W; ++l) {
+              if (!hb[l]) continue;
+              hit_level[l] = level;
+              hit_j[l] = j;
+              for (int c = 0; c < 4; ++c)
+                hit_b[l][c] = cb[c][l];
+            }
+          }
+          split = left && !hit;
+          if (level == kSettleLevel) {
+            open_lo = xsimd::select(split, xsimd::min(open_lo, B(lo_t)), open_lo);
+            continue;
+          }
           if (xsimd::none(split)) continue;
         }
         halve(cur[j], nxt[2 * j], nxt[2 * j + 1]);
         nxt_open[2 * j] = split && !one_sign(nxt[2 * j], e);
         nxt_open[2 * j + 1] = split && !one_sign(nxt[2 * j + 1], e);
-        any_open = any_open || nxt_open[2 * j] || nxt_open[2 * j + 1];
         next_slots |= std::uint64_t(xsimd::any(nxt_open[2 * j])) << (2 * j);
         next_slots |= std::uint64_t(xsimd::any(nxt_open[2 * j + 1])) << (2 * j + 1);
       }
-      // Done where every lane still missing has no range left (the others are settled).
-      if (level == kMissLevel || xsimd::none(missed && any_open)) break;
       slots = next_slots;
       now = 1 - now;
     }
-    missed = missed && (examined <= B(double(kFastPathBudget)));
-    bool m[W];
-    missed.store_unaligned(m);
-    for (int l = 0; l < n; ++l)
-      miss[kept[s + l]] = m[l];
+    bool act[W];
+    active.store_unaligned(act);
+    alignas(64) double hl[W], ol[W], el[W], count[W];
+    hit_lo.store_aligned(hl);
+    open_lo.store_aligned(ol);
+    e.store_aligned(el);
+    examined.store_aligned(count);
+    for (int l = 0; l < n; ++l) {
+      if (!act[l]) continue;
+      const int q = kept[s + l];
+      if (hl[l] == std::numeric_limits<double>::infinity()) {
+        // Nothing was left unvisited (no certified or open range): count is every range.
+        const bool dropped = ol[l] == std::numeric_limits<double>::infinity();
+        if (dropped && count[l] <= kFastPathBudget) settled[q] = FastSettled::Miss;
+        continue;
+      }
+      if (!(hl[l] < ol[l])) continue;
+      // The ranges examined in this lane that start at or before H = (hit_level, hit_j): at
+      // level v, indices up to hit_j scaled to that level.
+      const int hv = hit_level[l], hj = hit_j[l];
+      int before = 0;
+      for (int v = 0; v < kLevels; ++v) {
+        const std::uint64_t last =
+            v <= hv ? std::uint64_t(hj) >> (hv - v) : std::uint64_t(hj) << (v - hv);
+        const std::uint64_t upto = last >= 63 ? ~std::uint64_t(0) : (std::uint64_t(2) << last) - 1;
+        for (std::uint64_t bits = seen_slots[v] & upto; bits != 0; bits &= bits - 1) {
+          bool lanes[W];
+          seen[v][std::countr_zero(bits)].store_unaligned(lanes);
+          before += lanes[l] ? 1 : 0;
+        }
+      }
+      if (before > kFastPathBudget) continue;
+      const double width = 1.0 / (1 << hv);
+      toi[q] = first_root_bound(hit_b[l], width * hj, width * (hj + 1), hv, el[l],
+                                hv > target ? hv : target);
+      settled[q] = FastSettled::Hit;
+    }
   }
 }
 

@@ -1,4 +1,4 @@
-// np_filter_batch and fast_path_misses on the SSE2 baseline (every x86-64 processor).
+// np_filter_batch and fast_path_settle on the SSE2 baseline (every x86-64 processor).
 #define NP_BATCH_NAMESPACE sse2_impl
 #include "ccd/np_batch_impl.hpp"
 
@@ -8,8 +8,9 @@ void np_filter_batch_sse2(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   sse2_impl::np_filter_batch_impl<xsimd::sse2>(kind, b, verdict);
 }
 
-void fast_path_misses_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict, bool* miss) {
-  sse2_impl::fast_path_misses_impl<xsimd::sse2>(kind, b, verdict, miss);
+void fast_path_settle_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
+                           FastSettled* settled, double* toi) {
+  sse2_impl::fast_path_settle_impl<xsimd::sse2>(kind, b, verdict, target, settled, toi);
 }
 
 }  // namespace clothcd::ccd_detail

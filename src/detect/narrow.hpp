@@ -69,7 +69,8 @@ struct FeatureBatch {
   ccd_detail::NpBatch vf, ee;  // gathered positions
   std::array<std::pair<int, int>, kCapacity> vf_ids, ee_ids;
   std::array<ccd_detail::NpVerdict, kCapacity> verdict;
-  std::array<bool, kCapacity> miss;  // ccd_detail::fast_path_misses
+  std::array<ccd_detail::FastSettled, kCapacity> settled;  // ccd_detail::fast_path_settle
+  std::array<double, kCapacity> toi;
 };
 
 /// Triangle pairs waiting for the whole-triangle distance filter (triangles_filter_culls: where
@@ -314,15 +315,16 @@ struct FeatureContext {
 
   // A culled pair counts as culled by the NP filter where ccd_hit counts it so: always for the
   // separate filter, with the fast path where the NP filter is on (counted_np). With the fast
-  // path (batched_np() implies zero thickness), the kept pairs that fast_path_misses settles are
-  // the kernel's misses on path FastPath: nothing to count, nothing to report.
+  // path (batched_np() implies zero thickness), the kept pairs that fast_path_settle settles are
+  // the kernel's misses on path FastPath (nothing to count or report) and its certified hits
+  // (reported with the kernel's time of impact).
   void flush_vf(FeatureBatch& b, FeatureCounters& c, std::vector<VertexFaceCollision>& out) const {
     if (b.vf.size == 0) return;
     ccd_detail::np_filter_batch(ccd_detail::Kind::VertexFace, b.vf, b.verdict.data());
-    const bool misses = ccd.fast_path;
-    if (misses) {
-      ccd_detail::fast_path_misses(ccd_detail::Kind::VertexFace, b.vf, b.verdict.data(),
-                                   b.miss.data());
+    const bool settle = ccd.fast_path;
+    if (settle) {
+      ccd_detail::fast_path_settle(ccd_detail::Kind::VertexFace, b.vf, b.verdict.data(),
+                                   ccd.toi_tolerance, b.settled.data(), b.toi.data());
     }
     for (int i = 0; i < b.vf.size; ++i) {
       ++c.vf_tests;
@@ -330,9 +332,12 @@ struct FeatureContext {
         c.vf_np += np_filter ? 1 : 0;
         continue;
       }
-      if (misses && b.miss[i]) continue;  // the kernel's own answer: no contact, not NP-culled
       const auto [v, f] = b.vf_ids[i];
       const Face& t = topo->faces()[f];
+      if (settle && b.settled[i] != ccd_detail::FastSettled::Run) {  // the kernel's own answer
+        if (b.settled[i] == ccd_detail::FastSettled::Hit) out.push_back({v, f, t, b.toi[i]});
+        continue;
+      }
       const VertexFaceQuery q{v0[v], v0[t[0]], v0[t[1]], v0[t[2]],
                               v1[v], v1[t[0]], v1[t[1]], v1[t[2]]};
       double toi = 1.0;
@@ -344,10 +349,10 @@ struct FeatureContext {
   void flush_ee(FeatureBatch& b, FeatureCounters& c, std::vector<EdgeEdgeCollision>& out) const {
     if (b.ee.size == 0) return;
     ccd_detail::np_filter_batch(ccd_detail::Kind::EdgeEdge, b.ee, b.verdict.data());
-    const bool misses = ccd.fast_path;
-    if (misses) {
-      ccd_detail::fast_path_misses(ccd_detail::Kind::EdgeEdge, b.ee, b.verdict.data(),
-                                   b.miss.data());
+    const bool settle = ccd.fast_path;
+    if (settle) {
+      ccd_detail::fast_path_settle(ccd_detail::Kind::EdgeEdge, b.ee, b.verdict.data(),
+                                   ccd.toi_tolerance, b.settled.data(), b.toi.data());
     }
     for (int i = 0; i < b.ee.size; ++i) {
       ++c.ee_tests;
@@ -355,10 +360,13 @@ struct FeatureContext {
         c.ee_np += np_filter ? 1 : 0;
         continue;
       }
-      if (misses && b.miss[i]) continue;  // the kernel's own answer: no contact, not NP-culled
       const auto [ea, eb] = b.ee_ids[i];
       const Edge& a = topo->edges()[ea];
       const Edge& d = topo->edges()[eb];
+      if (settle && b.settled[i] != ccd_detail::FastSettled::Run) {  // the kernel's own answer
+        if (b.settled[i] == ccd_detail::FastSettled::Hit) out.push_back({ea, eb, a, d, b.toi[i]});
+        continue;
+      }
       const EdgeEdgeQuery q{v0[a[0]], v0[a[1]], v0[d[0]], v0[d[1]],
                             v1[a[0]], v1[a[1]], v1[d[0]], v1[d[1]]};
       double toi = 1.0;

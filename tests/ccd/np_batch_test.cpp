@@ -1,9 +1,9 @@
 // The batched NP filter (SSE2, AVX2, AVX-512 and the dispatching entry) against the scalar filter,
 // unscaled_np_filter: the same verdict for every query, on seeded random queries over many scales,
 // near-coplanar and exactly coplanar ones, out-of-range magnitudes and non-finite coordinates;
-// and no culled query that the exact oracle finds in contact. Likewise fast_path_misses against
-// its scalar reference and the kernel, with no missed query in contact; and make_motion's scale
-// and coordinates against their definitions.
+// and no culled query that the exact oracle finds in contact. Likewise fast_path_settle against
+// its scalar reference and the kernel, its misses and certified hits against the exact oracle;
+// and make_motion's scale and coordinates against their definitions.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -172,58 +172,84 @@ TEST(NpBatch, CullsNoQueryInContact) {
   EXPECT_GT(culled, 50);
 }
 
-// fast_path_misses on `qs` (at most a batch) from every instruction set: the scalar reference's
-// answers, and each miss the kernel's own verdict (no hit, path FastPath). Returns the misses.
-std::vector<bool> check_misses(Kind kind, const std::vector<Points>& qs, int& kept) {
+struct Settled {
+  int kept = 0, missed = 0, hits = 0;
+};
+
+// fast_path_settle on `qs` (at most a batch) from every instruction set: the scalar reference's
+// answers (times of impact bit for bit), each miss the kernel's own (no hit, path FastPath) and
+// each hit the kernel's own (path Certified, the same time of impact). Returns the answers.
+std::vector<ccd_detail::FastSettled> check_settled(Kind kind, const std::vector<Points>& qs,
+                                                   Settled& n, double toi_tolerance = 1e-4) {
+  using ccd_detail::FastSettled;
   NpBatch b;
   fill(b, qs);
   std::vector<NpVerdict> verdict(NpBatch::kCapacity);
   EXPECT_TRUE(ccd_detail::np_filter_batch_with(0, kind, b, verdict.data()));
-  bool expect[NpBatch::kCapacity], got[NpBatch::kCapacity];
-  EXPECT_TRUE(ccd_detail::fast_path_misses_with(0, kind, b, verdict.data(), expect));
+  FastSettled expect[NpBatch::kCapacity], got[NpBatch::kCapacity];
+  double expect_toi[NpBatch::kCapacity], got_toi[NpBatch::kCapacity];
+  EXPECT_TRUE(ccd_detail::fast_path_settle_with(0, kind, b, verdict.data(), toi_tolerance, expect,
+                                                expect_toi));
   for (int isa = 1; isa <= 4; ++isa) {
-    std::fill(std::begin(got), std::end(got), false);
+    std::fill(std::begin(got), std::end(got), FastSettled::Run);
     if (isa < 4) {
-      if (!ccd_detail::fast_path_misses_with(isa, kind, b, verdict.data(), got)) continue;
+      if (!ccd_detail::fast_path_settle_with(isa, kind, b, verdict.data(), toi_tolerance, got,
+                                             got_toi)) {
+        continue;
+      }
     } else {
-      ccd_detail::fast_path_misses(kind, b, verdict.data(), got);
+      ccd_detail::fast_path_settle(kind, b, verdict.data(), toi_tolerance, got, got_toi);
     }
-    for (std::size_t i = 0; i < qs.size(); ++i)
+    for (std::size_t i = 0; i < qs.size(); ++i) {
       EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " query " << i;
+      if (got[i] == FastSettled::Hit && expect[i] == FastSettled::Hit) {
+        EXPECT_EQ(got_toi[i], expect_toi[i]) << "isa " << isa << " query " << i;
+      }
+    }
   }
-  std::vector<bool> out(qs.size());
+  std::vector<FastSettled> out(expect, expect + qs.size());
   CcdOptions opt;
   opt.fast_path = true;
+  opt.toi_tolerance = toi_tolerance;
   for (std::size_t i = 0; i < qs.size(); ++i) {
-    kept += verdict[i] == NpVerdict::Kept;
-    out[i] = expect[i];
-    if (!expect[i]) continue;
+    n.kept += verdict[i] == NpVerdict::Kept;
+    if (expect[i] == FastSettled::Run) continue;
     EXPECT_EQ(verdict[i], NpVerdict::Kept);
     const CcdResult r = kind == Kind::VertexFace
                             ? ccd_detail::vertex_face_ccd_np_kept(vf_query(qs[i]), opt)
                             : ccd_detail::edge_edge_ccd_np_kept(ee_query(qs[i]), opt);
-    EXPECT_FALSE(r.hit) << "query " << i;
-    EXPECT_EQ(r.path, CcdPath::FastPath) << "query " << i;
+    if (expect[i] == FastSettled::Miss) {
+      ++n.missed;
+      EXPECT_FALSE(r.hit) << "query " << i;
+      EXPECT_EQ(r.path, CcdPath::FastPath) << "query " << i;
+    } else {
+      ++n.hits;
+      EXPECT_TRUE(r.hit) << "query " << i;
+      EXPECT_EQ(r.path, CcdPath::Certified) << "query " << i;
+      EXPECT_EQ(r.toi, expect_toi[i]) << "query " << i;
+    }
   }
   return out;
 }
 
-TEST(FastPathMisses, MatchTheKernelOnRandomQueries) {
-  int kept = 0, missed = 0;
+TEST(FastPathSettle, MatchTheKernelOnRandomQueries) {
+  Settled n;
   for (std::uint64_t seed = 200; seed < 240; ++seed) {
     Gen g(seed);
     for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
       std::vector<Points> qs;
-      const int n = seed % 2 == 0 ? NpBatch::kCapacity : g.integer(1, NpBatch::kCapacity);
-      for (int i = 0; i < n; ++i)
+      const int size = seed % 2 == 0 ? NpBatch::kCapacity : g.integer(1, NpBatch::kCapacity);
+      for (int i = 0; i < size; ++i)
         qs.push_back(make_query(g, g.integer(0, 5)));
-      for (const bool m : check_misses(kind, qs, kept))
-        missed += m;
+      // The kernel's default tolerance, none (refined to depth 40) and a coarse one.
+      const double tolerance[] = {1e-4, 0.0, 0.05};
+      check_settled(kind, qs, n, tolerance[seed % 3]);
     }
   }
-  // Both answers occur among the kept queries, so each lane path was compared.
-  EXPECT_GT(missed, 100);
-  EXPECT_GT(kept - missed, 100);
+  // Every answer occurs among the kept queries, so each lane path was compared.
+  EXPECT_GT(n.missed, 100);
+  EXPECT_GT(n.hits, 20);
+  EXPECT_GT(n.kept - n.missed - n.hits, 20);
 }
 
 // Exactly coplanar motion (every point in z = 0: the cubic is zero, never of one sign): a vertex
@@ -253,43 +279,43 @@ Points sliding_coplanar(Gen& g, Kind kind) {
   return p;
 }
 
-TEST(FastPathMisses, MatchTheKernelOnSlidingCoplanarQueries) {
-  int kept = 0, missed = 0;
+TEST(FastPathSettle, MatchTheKernelOnSlidingCoplanarQueries) {
+  Settled n;
   for (std::uint64_t seed = 400; seed < 404; ++seed) {
     Gen g(seed);
     for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
       std::vector<Points> qs;
       for (int i = 0; i < NpBatch::kCapacity; ++i)
         qs.push_back(sliding_coplanar(g, kind));
-      for (const bool m : check_misses(kind, qs, kept))
-        missed += m;
+      check_settled(kind, qs, n);
     }
   }
-  EXPECT_GT(missed, 10);
-  EXPECT_GT(kept - missed, 10);
+  EXPECT_GT(n.missed, 10);
+  EXPECT_GT(n.kept - n.missed - n.hits, 10);
 }
 
-TEST(FastPathMisses, MissNoQueryInContact) {
-  int kept = 0, missed = 0;
+TEST(FastPathSettle, MissNoQueryInContactAndHitOnlyThose) {
+  Settled n;
   for (std::uint64_t seed = 300; seed < 306; ++seed) {
     Gen g(seed);
     for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
       std::vector<Points> qs;
       for (int i = 0; i < 64; ++i)
         qs.push_back(make_query(g, g.integer(1, 3)));  // the families with contacts
-      const std::vector<bool> m = check_misses(kind, qs, kept);
+      const std::vector<ccd_detail::FastSettled> s = check_settled(kind, qs, n);
       for (std::size_t i = 0; i < qs.size(); ++i) {
-        if (!m[i]) continue;
-        ++missed;
-        EXPECT_FALSE(exact_contact(kind, qs[i])) << "seed " << seed << " query " << i;
+        if (s[i] == ccd_detail::FastSettled::Run) continue;
+        EXPECT_EQ(exact_contact(kind, qs[i]), s[i] == ccd_detail::FastSettled::Hit)
+            << "seed " << seed << " query " << i;
       }
     }
   }
-  EXPECT_GT(missed, 50);
+  EXPECT_GT(n.missed, 50);
+  EXPECT_GT(n.hits, 10);
 }
 
 // make_motion's scale: std::frexp's exponent, applied with std::ldexp, for every magnitude.
-TEST(FastPathMisses, InverseBinadeIsFrexpAndLdexp) {
+TEST(FastPathSettle, InverseBinadeIsFrexpAndLdexp) {
   Gen g(11);
   std::vector<double> ms = {0.0,
                             std::numeric_limits<double>::denorm_min(),
@@ -314,7 +340,7 @@ TEST(FastPathMisses, InverseBinadeIsFrexpAndLdexp) {
 }
 
 // make_motion against its vector-expression form, coordinate for coordinate.
-TEST(FastPathMisses, MakeMotionMatchesItsVectorForm) {
+TEST(FastPathSettle, MakeMotionMatchesItsVectorForm) {
   for (std::uint64_t seed = 400; seed < 420; ++seed) {
     Gen g(seed);
     for (int i = 0; i < 200; ++i) {
