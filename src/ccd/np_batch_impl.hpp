@@ -6,10 +6,13 @@
 
 #include <xsimd/xsimd.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cfloat>
 #include <cstdint>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "ccd/fast_path.hpp"
 #include "ccd/lanes.hpp"
@@ -96,9 +99,31 @@ void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   }
 }
 
-// fast_path_settle (np_batch.hpp): lane by lane, the kernel's operations on a query the NP filter
-// kept, from make_motion's scaling to the inside tests of the search down to kSettleLevel, each
-// as the scalar code performs it (the sources named at each step). `target`: toi_target_level.
+// fast_path_settle's working memory, one per thread: the per-query data of a batch and the time
+// ranges waiting for the inside test, a level at a time.
+struct SettleScratch {
+  static constexpr int kCap = NpBatch::kCapacity;
+  static constexpr int kLevels = kSettleLevel + 1;
+  struct Range {
+    int q, j;     // kept query, range [j, j + 1] / 2^level
+    double b[4];  // the cubic's Bernstein coefficients on it
+  };
+  double d[30][kCap];  // inside_data's difference vectors at t = 0 and 1 (scaled), per query
+  double e[kCap], ein[kCap];
+  bool active[kCap];  // the scaled cubic is not NP-culled
+  // The ranges examined per level (bit j: range j); the earliest certified and open ranges.
+  std::uint64_t examined[kCap][kLevels];
+  double hit_lo[kCap], open_lo[kCap];
+  int hit_level[kCap], hit_j[kCap];
+  double hit_b[kCap][4];
+  std::vector<Range> ranges, next;
+};
+
+// fast_path_settle (np_batch.hpp): the kernel's operations on the queries the NP filter kept, each
+// lane repeating the scalar code (the sources named at each step). Scaling, the cubic and the
+// first levels of halving run on W queries at a time; the inside tests, the bulk of the work, on
+// W time ranges at a time, gathered from all queries of the batch (a range's lanes are rarely
+// full otherwise: 1.4 of 4 on cloth_ball). `target`: toi_target_level.
 template <class Arch>
 void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
                            FastSettled* settled, double* toi) {
@@ -106,7 +131,11 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   using Mask = xsimd::batch_bool<double, Arch>;
   constexpr int W = static_cast<int>(B::size);
   static_assert(NpBatch::kCapacity % W == 0);
+  static_assert(kFirstInsideLevel == 2 && kSettleLevel < 64);
   using V = Vec3<B>;
+  using Range = SettleScratch::Range;
+  constexpr int kLevels = SettleScratch::kLevels;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
   struct I {  // certify.cpp's midpoint-radius interval
     B m, r;
   };
@@ -135,6 +164,7 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   const auto idot = [&](const IV& p, const IV& q) {
     return iadd(iadd(imul(p.x, q.x), imul(p.y, q.y)), imul(p.z, q.z));
   };
+  thread_local SettleScratch sc;
   // The kept queries only, W at a time (a partial group repeats its last query).
   int kept[NpBatch::kCapacity];
   int nk = 0;
@@ -144,6 +174,7 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
     kept[nk] = i;
     nk += verdict[i] == NpVerdict::Kept ? 1 : 0;
   }
+  sc.ranges.clear();
   for (int s = 0; s < nk; s += W) {
     const int n = nk - s < W ? nk - s : W;
     alignas(64) double col[24][W];
@@ -174,190 +205,242 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
     const B(&k)[4] = cubic.k;
     const B a = cubic.a;
     const B eta = eta_scale * (a * a * a) + eta_floor;
-    const Mask np_culled = one_sign(k, eta);
-    // fast_path_solve: subdivision_error, then the ranges down to the quarters of the step
-    // (kFirstInsideLevel), each dropped where the cubic keeps one sign on it or on its parent.
+    const Mask active = !one_sign(k, eta);
+    // fast_path_solve: subdivision_error, inside_data and inside_over's bound, kept per query.
     const B kmax =
         xsimd::max(xsimd::max(xsimd::max(xsimd::abs(k[0]), xsimd::abs(k[1])), xsimd::abs(k[2])),
                    xsimd::abs(k[3]));
     const B e = eta + sub_scale * kmax;
-    // inside_data and inside_over's bound.
-    V d0[5], d1[5];
     B amax(0.0);
-    for (int j = 0; j < 5; ++j) {
-      d0[j] = sub(x0[idx[j][0]], x0[idx[j][1]]);
-      d1[j] = sub(x1[idx[j][0]], x1[idx[j][1]]);
-      amax = xsimd::max(amax, xsimd::max(max_abs(d0[j]), max_abs(d1[j])));
+    for (int t = 0; t < 5; ++t) {
+      const V d0 = sub(x0[idx[t][0]], x0[idx[t][1]]);
+      const V d1 = sub(x1[idx[t][0]], x1[idx[t][1]]);
+      amax = xsimd::max(amax, xsimd::max(max_abs(d0), max_abs(d1)));
+      d0.x.store_unaligned(&sc.d[6 * t][s]);
+      d0.y.store_unaligned(&sc.d[6 * t + 1][s]);
+      d0.z.store_unaligned(&sc.d[6 * t + 2][s]);
+      d1.x.store_unaligned(&sc.d[6 * t + 3][s]);
+      d1.y.store_unaligned(&sc.d[6 * t + 4][s]);
+      d1.z.store_unaligned(&sc.d[6 * t + 5][s]);
     }
     const B mm = amax * widen;
     const B ein = in_scale * (mm * mm) * (mm * mm) + in_floor;
-    const auto below = [&](const I& g) { return g.m + g.r < -ein; };
-    const auto above = [&](const I& g) { return g.m - g.r > ein; };
-    struct Verdict {
-      Mask no, yes;
-    };
-    // inside_over over [lo, hi] in the lanes `need`: No (a function below -ein), Yes (all above
-    // ein). As soon as every such lane is No the other functions cannot change that, and Yes
-    // matters only where the answer is not No: stop there.
-    const auto inside = [&](double lo_t, double hi_t, const Mask& need) {
-      const B lo(lo_t), hi(hi_t);
+    e.store_unaligned(&sc.e[s]);
+    ein.store_unaligned(&sc.ein[s]);
+    // The search's first levels (no inside test before kFirstInsideLevel): the whole step, its
+    // halves, its quarters, each examined where the cubic is not of one sign on it and its
+    // parent was.
+    B half_b[2][4], quarter_b[4][4];
+    const Mask open0 = active && !one_sign(k, e);
+    halve(k, half_b[0], half_b[1]);
+    Mask open1[2], open2[4];
+    for (int h = 0; h < 2; ++h) {
+      open1[h] = open0 && !one_sign(half_b[h], e);
+      halve(half_b[h], quarter_b[2 * h], quarter_b[2 * h + 1]);
+      open2[2 * h] = open1[h] && !one_sign(quarter_b[2 * h], e);
+      open2[2 * h + 1] = open1[h] && !one_sign(quarter_b[2 * h + 1], e);
+    }
+    bool act[W], o0[W], o1[2][W], o2[4][W];
+    alignas(64) double qb[4][4][W];
+    active.store_unaligned(act);
+    open0.store_unaligned(o0);
+    for (int h = 0; h < 2; ++h)
+      open1[h].store_unaligned(o1[h]);
+    for (int j = 0; j < 4; ++j) {
+      open2[j].store_unaligned(o2[j]);
+      for (int c = 0; c < 4; ++c)
+        quarter_b[j][c].store_aligned(qb[j][c]);
+    }
+    for (int l = 0; l < n; ++l) {
+      const int q = s + l;
+      sc.active[q] = act[l];
+      sc.hit_lo[q] = sc.open_lo[q] = kInf;
+      std::uint64_t* ex = sc.examined[q];
+      for (int v = 0; v < kLevels; ++v)
+        ex[v] = 0;
+      ex[0] = o0[l] ? 1 : 0;
+      ex[1] = (o1[0][l] ? 1 : 0) | (o1[1][l] ? 2 : 0);
+      for (int j = 0; j < 4; ++j) {
+        if (o2[j][l])
+          sc.ranges.push_back(Range{q, j, {qb[j][0][l], qb[j][1][l], qb[j][2][l], qb[j][3][l]}});
+      }
+    }
+  }
+  // fast_path_solve's search, level by level from kFirstInsideLevel: it drops a range where the
+  // inside answer is No, certifies a hit where it is Yes and the cubic changes sign, and splits
+  // it otherwise into the halves on which the cubic is not of one sign (below kSettleLevel;
+  // deeper ranges are left to the kernel: "open"). Its depth-first order reaches a range after
+  // every earlier one and the ranges containing it. So a query is a miss when nothing is
+  // certified or open and it examined at most kFastPathBudget ranges, and a hit in its earliest
+  // certified range H when no open range starts before H and at most kFastPathBudget examined
+  // ranges start at or before H (the earlier ranges, the ranges containing H, and H). Ranges
+  // starting at or after a query's earliest certified or open range cannot change its answer
+  // and are not followed.
+  struct Verdict {
+    Mask no, yes;
+  };
+  for (int level = kFirstInsideLevel; level <= kSettleLevel && !sc.ranges.empty(); ++level) {
+    const double width = 1.0 / (1 << level);
+    sc.next.clear();
+    const std::size_t count = sc.ranges.size();
+    std::size_t r = 0;
+    while (r < count) {
+      // The next W ranges still worth examining (a partial group repeats its last range).
+      const Range* g[W];
+      int m = 0;
+      for (; r < count && m < W; ++r) {
+        const Range& rg = sc.ranges[r];
+        if (width * rg.j < std::min(sc.hit_lo[rg.q], sc.open_lo[rg.q])) g[m++] = &rg;
+      }
+      if (m == 0) break;
+      for (int l = m; l < W; ++l)
+        g[l] = g[m - 1];
+      // Row by row, so that each row's W values become one vector without a memory round trip.
+      int gq[W];
+      for (int l = 0; l < W; ++l)
+        gq[l] = g[l]->q;
+      alignas(64) double col[38][W];
+      for (int row = 0; row < 30; ++row) {
+        for (int l = 0; l < W; ++l)
+          col[row][l] = sc.d[row][gq[l]];
+      }
+      for (int l = 0; l < W; ++l) {
+        col[30][l] = sc.e[gq[l]];
+        col[31][l] = sc.ein[gq[l]];
+      }
+      for (int c = 0; c < 4; ++c) {
+        for (int l = 0; l < W; ++l)
+          col[32 + c][l] = g[l]->b[c];
+      }
+      for (int l = 0; l < W; ++l) {
+        col[36][l] = width * g[l]->j;
+        col[37][l] = width * (g[l]->j + 1);
+      }
+      V d0[5], d1[5];
+      for (int t = 0; t < 5; ++t) {
+        d0[t] = V{B::load_aligned(col[6 * t]), B::load_aligned(col[6 * t + 1]),
+                  B::load_aligned(col[6 * t + 2])};
+        d1[t] = V{B::load_aligned(col[6 * t + 3]), B::load_aligned(col[6 * t + 4]),
+                  B::load_aligned(col[6 * t + 5])};
+      }
+      const B e = B::load_aligned(col[30]), ein = B::load_aligned(col[31]);
+      const B cb[4] = {B::load_aligned(col[32]), B::load_aligned(col[33]), B::load_aligned(col[34]),
+                       B::load_aligned(col[35])};
+      const B lo = B::load_aligned(col[36]), hi = B::load_aligned(col[37]);
+      // inside_over over [lo, hi]: No (a function below -ein), Yes (all above ein). As soon as
+      // every lane is No the other functions cannot change that, and Yes matters only where the
+      // answer is not No: stop there.
+      const auto below = [&](const I& f) { return f.m + f.r < -ein; };
+      const auto above = [&](const I& f) { return f.m - f.r > ein; };
       const auto at = [&](int t) {
         const auto one = [&](const B& p0, const B& p1) {
           const B dx = p1 - p0;
-          const B p = p0 + lo * dx, r = p0 + hi * dx;
-          return I{(p + r) * half, xsimd::abs(r - p) * half};
+          const B p = p0 + lo * dx, q = p0 + hi * dx;
+          return I{(p + q) * half, xsimd::abs(q - p) * half};
         };
         return IV{one(d0[t].x, d1[t].x), one(d0[t].y, d1[t].y), one(d0[t].z, d1[t].z)};
       };
-      Verdict v{Mask(false), Mask(true)};
-      const auto add = [&](const I& g) {
-        v.no = v.no || below(g);
-        v.yes = v.yes && above(g);
-        return xsimd::none(need && !v.no);
-      };
-      const IV x0 = at(0), x1 = at(1), x2 = at(2);
-      const IV nn = icross(x0, x1);
-      if (kind == Kind::VertexFace) {
-        if (add(idot(nn, icross(x0, x2)))) return v;
-        const IV x3 = at(3), x4 = at(4);
-        if (add(idot(nn, icross(x3, x4)))) return v;
-        add(idot(nn, icross(x2, x1)));
+      const Verdict in = [&] {
+        Verdict v{Mask(false), Mask(true)};
+        const auto add = [&](const I& f) {
+          v.no = v.no || below(f);
+          v.yes = v.yes && above(f);
+          return xsimd::all(v.no);
+        };
+        const IV x0 = at(0), x1 = at(1), x2 = at(2);
+        const IV nn = icross(x0, x1);
+        if (kind == Kind::VertexFace) {
+          if (add(idot(nn, icross(x0, x2)))) return v;
+          const IV x3 = at(3), x4 = at(4);
+          if (add(idot(nn, icross(x3, x4)))) return v;
+          add(idot(nn, icross(x2, x1)));
+          return v;
+        }
+        if (add(idot(nn, icross(x2, x1)))) return v;
+        const IV x3 = at(3);
+        if (add(idot(nn, icross(x3, x1)))) return v;
+        if (add(idot(nn, icross(x2, x0)))) return v;
+        add(idot(nn, icross(at(4), x0)));
         return v;
+      }();
+      const Mask left = !in.no;
+      const Mask change = ((cb[0] > e) && (cb[3] < -e)) || ((cb[0] < -e) && (cb[3] > e));
+      const Mask hit = left && in.yes && change;
+      const Mask split = left && !hit;
+      bool lf[W], ht[W], sl[W] = {}, sr[W] = {};
+      left.store_unaligned(lf);
+      hit.store_unaligned(ht);
+      alignas(64) double kb[2][4][W];
+      if (level < kSettleLevel && xsimd::any(split)) {
+        B lb[4], rb[4];
+        halve(cb, lb, rb);
+        (split && !one_sign(lb, e)).store_unaligned(sl);
+        (split && !one_sign(rb, e)).store_unaligned(sr);
+        for (int c = 0; c < 4; ++c) {
+          lb[c].store_aligned(kb[0][c]);
+          rb[c].store_aligned(kb[1][c]);
+        }
       }
-      if (add(idot(nn, icross(x2, x1)))) return v;
-      const IV x3 = at(3);
-      if (add(idot(nn, icross(x3, x1)))) return v;
-      if (add(idot(nn, icross(x2, x0)))) return v;
-      add(idot(nn, icross(at(4), x0)));
-      return v;
-    };
-    // fast_path_solve's search, level by level: range j of a level spans [j, j + 1] / 2^level.
-    // The kernel examines every range whose parent it splits unless the cubic keeps one sign on
-    // it; from kFirstInsideLevel on it drops the range where the inside answer is No, certifies
-    // a hit where it is Yes and the cubic changes sign, and splits it otherwise (below
-    // kSettleLevel; deeper ranges are left to it: "open"). Its depth-first order reaches a range
-    // after every earlier one and the ranges containing it. So a lane is a miss when nothing is
-    // certified or open and it examined at most kFastPathBudget ranges, and a hit in its
-    // earliest certified range H when no open range starts before H and at most
-    // kFastPathBudget examined ranges start at or before H (the earlier ranges, the ranges
-    // containing H, and H). Ranges starting at or after a lane's earliest certified or open
-    // range cannot change its answer and are not followed.
-    constexpr int kSlots = 1 << kSettleLevel;
-    static_assert(kSlots <= 64);
-    constexpr int kLevels = kSettleLevel + 1;
-    B coef[2][kSlots][4];  // this level's ranges and the next one's, alternately
-    Mask open[2][kSlots];  // valid where the level's `slots` bit is set
-    int now = 0;
-    const Mask active = !np_culled;
-    const B inf(std::numeric_limits<double>::infinity());
-    B hit_lo = inf, open_lo = inf;  // start of the earliest certified, open range
-    // The ranges examined: how many per lane, in which lanes (seen, valid where the level's
-    // seen_slots bit is set); and per lane the earliest certified range's level, index and
-    // coefficients.
-    const B one(1.0), zero(0.0);
-    B examined(0.0);
-    Mask seen[kLevels][kSlots];
-    std::uint64_t seen_slots[kLevels] = {};
-    int hit_level[W] = {}, hit_j[W] = {};
-    double hit_b[W][4] = {};
-    for (int c = 0; c < 4; ++c)
-      coef[0][0][c] = k[c];
-    open[0][0] = active && !one_sign(k, e);
-    // The ranges open in some lane, one bit each: only those are visited.
-    std::uint64_t slots = xsimd::any(open[0][0]) ? 1u : 0u;
-    for (int level = 0; level <= kSettleLevel && slots != 0; ++level) {
-      const int count = 1 << level;
-      const double width = 1.0 / count;
-      B(&cur)[kSlots][4] = coef[now];
-      B(&nxt)[kSlots][4] = coef[1 - now];
-      const Mask* cur_open = open[now];
-      Mask* nxt_open = open[1 - now];
-      std::uint64_t next_slots = 0;
-      for (std::uint64_t bits = slots; bits != 0; bits &= bits - 1) {
-        const int j = std::countr_zero(bits);
-        const double lo_t = width * j;
-        const Mask need = cur_open[j] && (B(lo_t) < xsimd::min(hit_lo, open_lo));
-        if (xsimd::none(need)) continue;
-        examined = examined + xsimd::select(need, one, zero);
-        seen[level][j] = need;
-        seen_slots[level] |= std::uint64_t(1) << j;
-        Mask split = need;
-        if (level >= kFirstInsideLevel) {
-          const Verdict in = inside(lo_t, width * (j + 1), need);
-          const Mask left = need && !in.no;
-          const Mask change =
-              ((cur[j][0] > e) && (cur[j][3] < -e)) || ((cur[j][0] < -e) && (cur[j][3] > e));
-          const Mask hit = left && in.yes && change;
-          if (xsimd::any(hit)) {
-            // The earliest so far in these lanes: ranges are visited in time order per level,
-            // and need keeps only ranges before the lane's earliest certified one.
-            hit_lo = xsimd::select(hit, B(lo_t), hit_lo);
-            bool hb[W];
-            hit.store_unaligned(hb);
-            alignas(64) double cb[4][W];
+      for (int l = 0; l < m; ++l) {
+        const Range& rg = *g[l];
+        const int q = rg.q;
+        sc.examined[q][level] |= std::uint64_t(1) << rg.j;
+        if (!lf[l]) continue;
+        const double lo_t = col[36][l];
+        if (ht[l]) {
+          if (lo_t < sc.hit_lo[q]) {
+            sc.hit_lo[q] = lo_t;
+            sc.hit_level[q] = level;
+            sc.hit_j[q] = rg.j;
             for (int c = 0; c < 4; ++c)
-              cur[j][c].store_aligned(cb[c]);
-            for (int l = 0; l < W; ++l) {
-              if (!hb[l]) continue;
-              hit_level[l] = level;
-              hit_j[l] = j;
-              for (int c = 0; c < 4; ++c)
-                hit_b[l][c] = cb[c][l];
-            }
+              sc.hit_b[q][c] = rg.b[c];
           }
-          split = left && !hit;
-          if (level == kSettleLevel) {
-            open_lo = xsimd::select(split, xsimd::min(open_lo, B(lo_t)), open_lo);
-            continue;
-          }
-          if (xsimd::none(split)) continue;
+          continue;
         }
-        halve(cur[j], nxt[2 * j], nxt[2 * j + 1]);
-        nxt_open[2 * j] = split && !one_sign(nxt[2 * j], e);
-        nxt_open[2 * j + 1] = split && !one_sign(nxt[2 * j + 1], e);
-        next_slots |= std::uint64_t(xsimd::any(nxt_open[2 * j])) << (2 * j);
-        next_slots |= std::uint64_t(xsimd::any(nxt_open[2 * j + 1])) << (2 * j + 1);
-      }
-      slots = next_slots;
-      now = 1 - now;
-    }
-    bool act[W];
-    active.store_unaligned(act);
-    alignas(64) double hl[W], ol[W], el[W], count[W];
-    hit_lo.store_aligned(hl);
-    open_lo.store_aligned(ol);
-    e.store_aligned(el);
-    examined.store_aligned(count);
-    for (int l = 0; l < n; ++l) {
-      if (!act[l]) continue;
-      const int q = kept[s + l];
-      if (hl[l] == std::numeric_limits<double>::infinity()) {
-        // Nothing was left unvisited (no certified or open range): count is every range.
-        const bool dropped = ol[l] == std::numeric_limits<double>::infinity();
-        if (dropped && count[l] <= kFastPathBudget) settled[q] = FastSettled::Miss;
-        continue;
-      }
-      if (!(hl[l] < ol[l])) continue;
-      // The ranges examined in this lane that start at or before H = (hit_level, hit_j): at
-      // level v, indices up to hit_j scaled to that level.
-      const int hv = hit_level[l], hj = hit_j[l];
-      int before = 0;
-      for (int v = 0; v < kLevels; ++v) {
-        const std::uint64_t last =
-            v <= hv ? std::uint64_t(hj) >> (hv - v) : std::uint64_t(hj) << (v - hv);
-        const std::uint64_t upto = last >= 63 ? ~std::uint64_t(0) : (std::uint64_t(2) << last) - 1;
-        for (std::uint64_t bits = seen_slots[v] & upto; bits != 0; bits &= bits - 1) {
-          bool lanes[W];
-          seen[v][std::countr_zero(bits)].store_unaligned(lanes);
-          before += lanes[l] ? 1 : 0;
+        if (level == kSettleLevel) {
+          sc.open_lo[q] = std::min(sc.open_lo[q], lo_t);
+          continue;
+        }
+        if (sl[l]) {
+          sc.next.push_back(
+              Range{q, 2 * rg.j, {kb[0][0][l], kb[0][1][l], kb[0][2][l], kb[0][3][l]}});
+        }
+        if (sr[l]) {
+          sc.next.push_back(
+              Range{q, 2 * rg.j + 1, {kb[1][0][l], kb[1][1][l], kb[1][2][l], kb[1][3][l]}});
         }
       }
-      if (before > kFastPathBudget) continue;
-      const double width = 1.0 / (1 << hv);
-      toi[q] = first_root_bound(hit_b[l], width * hj, width * (hj + 1), hv, el[l],
-                                hv > target ? hv : target);
-      settled[q] = FastSettled::Hit;
     }
+    std::swap(sc.ranges, sc.next);
+  }
+  for (int q = 0; q < nk; ++q) {
+    if (!sc.active[q]) continue;
+    const std::uint64_t* ex = sc.examined[q];
+    if (sc.hit_lo[q] == kInf) {
+      // Nothing was left unfollowed (no certified or open range): every range is counted.
+      if (sc.open_lo[q] != kInf) continue;
+      int total = 0;
+      for (int v = 0; v < kLevels; ++v)
+        total += std::popcount(ex[v]);
+      if (total <= kFastPathBudget) settled[kept[q]] = FastSettled::Miss;
+      continue;
+    }
+    if (!(sc.hit_lo[q] < sc.open_lo[q])) continue;
+    // The examined ranges that start at or before H = (hit_level, hit_j): at level v, indices up
+    // to hit_j scaled to that level.
+    const int hv = sc.hit_level[q], hj = sc.hit_j[q];
+    int before = 0;
+    for (int v = 0; v < kLevels; ++v) {
+      const std::uint64_t last =
+          v <= hv ? std::uint64_t(hj) >> (hv - v) : std::uint64_t(hj) << (v - hv);
+      const std::uint64_t upto = last >= 63 ? ~std::uint64_t(0) : (std::uint64_t(2) << last) - 1;
+      before += std::popcount(ex[v] & upto);
+    }
+    if (before > kFastPathBudget) continue;
+    const double width = 1.0 / (1 << hv);
+    toi[kept[q]] = first_root_bound(sc.hit_b[q], width * hj, width * (hj + 1), hv, sc.e[q],
+                                    hv > target ? hv : target);
+    settled[kept[q]] = FastSettled::Hit;
   }
 }
 
