@@ -40,7 +40,8 @@ struct LaneCubic {
   B a;
 };
 template <class B>
-LaneCubic<B> coplanarity_cubic(Kind kind, const Vec3<B> (&x0)[4], const Vec3<B> (&x1)[4]) {
+[[gnu::always_inline]] inline LaneCubic<B> coplanarity_cubic(Kind kind, const Vec3<B> (&x0)[4],
+                                                             const Vec3<B> (&x1)[4]) {
   // Point indices of a, b, c, q (as in cubic_of).
   const int ia = kind == Kind::VertexFace ? 1 : 0;
   const int ib = kind == Kind::VertexFace ? 2 : 1;
