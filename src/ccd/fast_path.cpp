@@ -55,26 +55,17 @@ int toi_target_level(double toi_tolerance) {
   return std::clamp(1 - exp, 0, kMaxRefine);
 }
 
-FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
-                            const InclusionParams& p) {
+namespace {
+
+// The search of fast_path_solve down to depth `max_level`. `undecided(lo, hi)` receives what the
+// search cannot decide itself: a range still undecided at max_level, or, past the budget, the rest
+// of the step [lo, 1] (then the search ends whatever it returns); it returns true to end the
+// search. Sets `out` for a certified hit.
+template <class Undecided>
+void search(Kind kind, const Motion& m, const BernsteinCubic& c, int target, int max_level,
+            FastOutcome& out, Undecided&& undecided) {
   const double e = subdivision_error(c);
   const InsideData data = inside_data(kind, m);
-  const int target = toi_target_level(p.toi_tolerance);
-  FastOutcome out;
-  InclusionParams q = p;
-  auto include = [&](double lo, double hi) {
-    q.t_lo = lo;
-    q.t_hi = hi;
-    const InclusionOutcome o = inclusion_solve(kind, m, q);
-    out.boxes += o.boxes;
-    if (o.hit) {
-      out.hit = true;
-      out.toi = o.toi;
-      out.u = o.u;
-      out.v = o.v;
-    }
-    return o.hit;
-  };
   Node stack[kMaxLevel + 2];
   int n = 0;
   stack[n++] = Node{{c.k[0], c.k[1], c.k[2], c.k[3]}, 0.0, 1.0, 0};
@@ -92,8 +83,8 @@ FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
     const Node nd = stack[--n];
     if (one_sign(nd.b, e)) continue;
     if (++visited > kBudget) {
-      include(nd.lo, 1.0);
-      return out;
+      undecided(nd.lo, 1.0);
+      return;
     }
     if (nd.level < kFirstInsideLevel) {
       split(nd);
@@ -109,15 +100,46 @@ FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
       out.toi = first_root_bound(nd.b, nd.lo, nd.hi, nd.level, e, std::max(target, nd.level));
       out.u = u;
       out.v = v;
-      return out;
+      return;
     }
-    if (nd.level >= kMaxLevel) {
-      if (include(nd.lo, nd.hi)) return out;
+    if (nd.level >= max_level) {
+      if (undecided(nd.lo, nd.hi)) return;
       continue;
     }
     split(nd);
   }
+}
+
+}  // namespace
+
+FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
+                            const InclusionParams& p) {
+  FastOutcome out;
+  InclusionParams q = p;
+  search(kind, m, c, toi_target_level(p.toi_tolerance), kMaxLevel, out, [&](double lo, double hi) {
+    q.t_lo = lo;
+    q.t_hi = hi;
+    const InclusionOutcome o = inclusion_solve(kind, m, q);
+    out.boxes += o.boxes;
+    if (o.hit) {
+      out.hit = true;
+      out.toi = o.toi;
+      out.u = o.u;
+      out.v = o.v;
+    }
+    return o.hit;
+  });
   return out;
+}
+
+bool fast_path_search(Kind kind, const Motion& m, const BernsteinCubic& c, int target,
+                      int max_level, FastOutcome& out) {
+  bool decided = true;
+  search(kind, m, c, target, max_level, out, [&](double, double) {
+    decided = false;
+    return true;
+  });
+  return decided;
 }
 
 }  // namespace clothcd::ccd_detail

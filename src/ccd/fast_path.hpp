@@ -37,6 +37,13 @@ int toi_target_level(double toi_tolerance);
 double first_root_bound(const double (&b)[4], double lo, double hi, int level, double e,
                         int target);
 
+/// fast_path_solve's search alone, to depth max_level (at most kFastPathMaxLevel): true, with
+/// `out` the kernel's outcome (no contact, or a certified hit), where the search ends without
+/// the inclusion solver; false where it would call it (a range still undecided at max_level, or
+/// the budget spent). `target`: toi_target_level of the kernel's tolerance.
+bool fast_path_search(Kind kind, const Motion& m, const BernsteinCubic& c, int target,
+                      int max_level, FastOutcome& out);
+
 /// `p` gives the inclusion solver's settings (its time range is ignored); `c` is the query's
 /// coplanarity cubic (not NP-culled).
 FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,

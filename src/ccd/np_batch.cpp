@@ -1,7 +1,5 @@
 #include "ccd/np_batch.hpp"
 
-#include <algorithm>
-
 #include "ccd/certify.hpp"
 #include "ccd/fast_path.hpp"
 #include "ccd/isa.hpp"
@@ -36,46 +34,19 @@ void np_filter_batch_scalar(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   }
 }
 
-// fast_path_solve's search for one kept query, step for step, stopping where it would split a
-// range below kSettleLevel (Run) or pass its budget (Run).
+// The kernel's own steps for one kept query (queries.cpp run, then fast_path_solve's search),
+// stopping where the search would call the inclusion solver or go below kSettleLevel (Run).
 FastSettled settle_scalar(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points,
                           int target, double& toi) {
   const Motion m = make_motion(points);
   if (!(m.max_abs.maxCoeff() > 0)) return FastSettled::Run;  // run() reports contact at t = 0
   const BernsteinCubic c = coplanarity_cubic(kind, m);
   if (np_culls(c)) return FastSettled::Run;  // path NpCulled
-  const double e = subdivision_error(c);
-  const InsideData data = inside_data(kind, m);
-  struct Node {
-    double b[4];
-    double lo, hi;
-    int level;
-  };
-  Node stack[kSettleLevel + 2];
-  int n = 0;
-  stack[n++] = Node{{c.k[0], c.k[1], c.k[2], c.k[3]}, 0.0, 1.0, 0};
-  int visited = 0;
-  while (n > 0) {
-    const Node nd = stack[--n];
-    if (one_sign(nd.b, e)) continue;
-    if (++visited > kFastPathBudget) return FastSettled::Run;
-    if (nd.level >= kFirstInsideLevel) {
-      double u = 0, v = 0;
-      const Inside in = inside_over(data, nd.lo, nd.hi, u, v);
-      if (in == Inside::No) continue;
-      if (in == Inside::Yes && sign_change(nd.b, e)) {
-        toi = first_root_bound(nd.b, nd.lo, nd.hi, nd.level, e, std::max(target, nd.level));
-        return FastSettled::Hit;
-      }
-      if (nd.level >= kSettleLevel) return FastSettled::Run;
-    }
-    const double mid = (nd.lo + nd.hi) * 0.5;
-    Node l{{}, nd.lo, mid, nd.level + 1}, r{{}, mid, nd.hi, nd.level + 1};
-    halve(nd.b, l.b, r.b);
-    stack[n++] = r;
-    stack[n++] = l;
-  }
-  return FastSettled::Miss;
+  FastOutcome out;
+  if (!fast_path_search(kind, m, c, target, kSettleLevel, out)) return FastSettled::Run;
+  if (!out.hit) return FastSettled::Miss;
+  toi = out.toi;
+  return FastSettled::Hit;
 }
 
 void settle_batch_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
