@@ -225,6 +225,26 @@ def test_cull_min_triangles_changes_the_work_not_the_results():
         det.set_options(cull_min_triangles=-1)
 
 
+def test_reuse_front_changes_the_work_not_the_results():
+    F, V0, V1 = clothcd.procedural.crumpled_sheet(16, 3)
+    det = clothcd.SelfDetector(F, V0, culling="none", reuse_front=True)
+    plain = clothcd.SelfDetector(F, V0, culling="none")
+    assert det.options["reuse_front"] and not plain.options["reuse_front"]
+    steps = [V0 + (V1 - V0) * (k / 4) for k in range(5)]
+    for k in range(4):
+        r, r0 = det.detect(steps[k], steps[k + 1]), plain.detect(steps[k], steps[k + 1])
+        assert np.array_equal(r.vf, r0.vf) and np.array_equal(r.vf_toi, r0.vf_toi)
+        assert np.array_equal(r.ee, r0.ee) and np.array_equal(r.ee_toi, r0.ee_toi)
+        assert r.stats["front_pairs"] > 0 and r0.stats["front_pairs"] == 0
+        # The first call starts at the root pairs; the later ones test fewer boxes from the front.
+        if k == 0:
+            assert r.stats["box_tests"] == r0.stats["box_tests"]
+        else:
+            assert r.stats["box_tests"] < r0.stats["box_tests"]
+    det.set_options(reuse_front=False)
+    assert det.detect(V0, V1).stats["front_pairs"] == 0
+
+
 def test_float32_and_lists_are_accepted():
     F, V0, V1 = clothcd.procedural.stacked_sheets(6)
     det = clothcd.SelfDetector(F.tolist(), V0.tolist())

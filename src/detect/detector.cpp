@@ -21,6 +21,7 @@
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/research/names.hpp"
 #include "contour.hpp"
+#include "front.hpp"
 #include "narrow.hpp"
 #include "options.hpp"
 #include "orphans.hpp"
@@ -112,6 +113,10 @@ struct SelfDetector::Impl {
   detail::Ownership owner;
   // The traversal's pair blocks, kept from call to call (pair_list.hpp).
   PairLocals pair_locals;
+  // Where the last unrestricted detect() with opt.reuse_front stopped below each internal node,
+  // and which internal nodes' child pairs the current call traverses (front.hpp).
+  detail::TraversalFront front;
+  std::vector<std::uint8_t> front_live;
   // The triangle pairs of the last unrestricted detect() with boxes widened to
   // opt.reuse_distance that are at most that far apart at t1 (the others' features are farther,
   // wherever their vertices still are), and its positions at t1: a proximity query at most that
@@ -248,6 +253,74 @@ struct SelfDetector::Impl {
     st.cone_tests = c.cone_tests;
     st.contour_tests = c.contour_tests;
     st.contour_fails = c.contour_fails;
+    for (const auto& l : locals) {
+      pairs.add(l.pairs);
+      st.adjacent_pairs += l.adjacent;
+    }
+    return pairs;
+  }
+
+  // traverse() from the front of the last call that used one (DetectOptions::reuse_front): the
+  // same leaf pairs and self tests; only the pairs' order and the box tests differ. Unrestricted
+  // calls only.
+  detail::PairList traverse_front(Rule mode, DetectStats& st, PairLocals& locals) {
+    const auto& nodes = bvh.nodes();
+    for (PairBuffer& l : locals) {
+      l.pairs.clear();
+      l.adjacent = 0;
+    }
+    detail::PairList pairs;
+    if (nodes.empty()) return pairs;
+    // The self tests traverse() makes, a level at a time: bit 0 of front_live[n], the self test
+    // of n runs (its parent's did and was not culled); bit 1, n is internal and not culled, so
+    // the pairs of its children are traversed.
+    front_live.assign(nodes.size(), 0);
+    front_live[0] = 1;
+    tbb::enumerable_thread_specific<detail::TraversalCounters> counters;
+    const auto& levels = bvh.level_offsets();
+    for (std::size_t d = 0; d + 1 < levels.size(); ++d) {
+      tbb::parallel_for(tbb::blocked_range<int>(levels[d], levels[d + 1], 64),
+                        [&](const tbb::blocked_range<int>& r) {
+                          detail::TraversalCounters& c = counters.local();
+                          for (int i = r.begin(); i != r.end(); ++i) {
+                            const BvhNode& n = nodes[i];
+                            if (front_live[i] == 0 || n.is_leaf()) continue;
+                            if (culls(mode, i, c)) {
+                              ++c.culled;
+                              continue;
+                            }
+                            front_live[i] |= 2;
+                            front_live[n.left] = front_live[n.left + 1] = 1;
+                          }
+                        });
+    }
+    if (front.empty()) {
+      std::vector<detail::TraversalFront::Root> roots;
+      for (int i = 0; i < static_cast<int>(nodes.size()); ++i) {
+        if (!nodes[i].is_leaf()) roots.push_back({i, nodes[i].left, nodes[i].left + 1});
+      }
+      front.seed(roots);
+    }
+    const auto& prims = bvh.prim_ids();
+    auto leaf = [np = nodes.data(), pp = prims.data(), fp = topo.faces().data()](int a, int b,
+                                                                                 PairBuffer& out) {
+      const int fa = pp[np[a].first], fb = pp[np[b].first];
+      if (faces_touch(fp[fa], fp[fb])) {
+        ++out.adjacent;
+        return;
+      }
+      out.pairs.push(fa, fb);
+    };
+    st.box_tests = front.run(
+        bvh, bvh, [&](int n) { return (front_live[n] & 2) != 0; }, leaf, locals);
+    detail::TraversalCounters c;
+    for (const auto& k : counters)
+      c.add(k);
+    st.nodes_culled = c.culled;
+    st.cone_tests = c.cone_tests;
+    st.contour_tests = c.contour_tests;
+    st.contour_fails = c.contour_fails;
+    st.front_pairs = front.size();
     for (const auto& l : locals) {
       pairs.add(l.pairs);
       st.adjacent_pairs += l.adjacent;
@@ -688,7 +761,10 @@ struct SelfDetector::Impl {
     DetectStats& st = res.stats;
     refit(st);
     auto t = Clock::now();
-    const detail::PairList pairs = traverse(rule(), st, pair_locals);
+    if (!opt.reuse_front && !front.empty()) front.clear();
+    const detail::PairList pairs = opt.reuse_front && !restricted
+                                       ? traverse_front(rule(), st, pair_locals)
+                                       : traverse(rule(), st, pair_locals);
     st.time_traverse = seconds_since(t);
     t = Clock::now();
     detail::FeatureContext ctx = ccd_context();
@@ -891,6 +967,7 @@ void rebuild_detector(Impl& im, detail::PointsIn reference) {
   im.bvh = Bvh(im.topo, ref, im.opt.build);
   im.bvh_call = 0;
   im.restricted = false;  // its node flags belonged to the old tree
+  im.front.clear();       // and so did the front's node pairs
 }
 }  // namespace
 

@@ -14,6 +14,7 @@
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/oracle.hpp"
+#include "front.hpp"
 #include "narrow.hpp"
 #include "options.hpp"
 #include "positions.hpp"
@@ -216,10 +217,13 @@ struct PairDetector::Impl {
   };
   tbb::enumerable_thread_specific<Pairs> pair_locals;
   std::vector<std::pair<int, int>> pairs_found;
+  // Where the last unrestricted detect() with opt.reuse_front stopped (front.hpp).
+  detail::TraversalFront front;
 
   // Overlapping leaf pairs (face of A, face of B), below active nodes when restricted; valid
-  // until the next call.
-  const std::vector<std::pair<int, int>>& traverse(DetectStats& st) {
+  // until the next call. `from_front`: start from the front (unrestricted calls only), and keep
+  // the new one.
+  const std::vector<std::pair<int, int>>& traverse(DetectStats& st, bool from_front = false) {
     std::vector<std::pair<int, int>>& pairs = pairs_found;
     pairs.clear();
     const auto& na = a.bvh.nodes();
@@ -227,6 +231,22 @@ struct PairDetector::Impl {
     if (na.empty() || nb.empty()) return pairs;
     const auto& pa = a.bvh.prim_ids();
     const auto& pb = b.bvh.prim_ids();
+    if (from_front) {
+      for (auto& l : pair_locals)
+        l.v.clear();
+      if (front.empty()) {
+        const detail::TraversalFront::Root root{0, 0, 0};
+        front.seed({&root, 1});
+      }
+      st.box_tests = front.run(
+          a.bvh, b.bvh, [](int) { return true; },
+          [&](int x, int y, Pairs& out) { out.v.emplace_back(pa[na[x].first], pb[nb[y].first]); },
+          pair_locals);
+      st.front_pairs = front.size();
+      for (const auto& l : pair_locals)
+        pairs.insert(pairs.end(), l.v.begin(), l.v.end());
+      return pairs;
+    }
     std::span<const std::uint8_t> act_a, act_b;
     if (restricted) {
       act_a = a.node_active;
@@ -258,7 +278,8 @@ struct PairDetector::Impl {
 
     t = Clock::now();
     DetectStats st;
-    const auto& pairs = traverse(st);
+    if (!opt.reuse_front && !front.empty()) front.clear();
+    const auto& pairs = traverse(st, opt.reuse_front && !restricted);
     const double t_trav = seconds_since(t);
 
     t = Clock::now();
@@ -311,6 +332,7 @@ struct PairDetector::Impl {
         });
     PairDetectResult res = collect(locals);
     res.stats.box_tests = st.box_tests;
+    res.stats.front_pairs = st.front_pairs;
     res.stats.triangle_pairs = pairs.size();
     res.stats.time_refit = t_refit;
     res.stats.time_traverse = t_trav;
@@ -413,6 +435,7 @@ void rebuild_detector(Impl& m, detail::PointsIn reference_a, detail::PointsIn re
   m.b.bvh = Bvh::boxes_only(m.b.topo, rb, m.opt.build);
   m.a.bvh_call = m.b.bvh_call = 0;
   m.restricted = false;  // its node flags belonged to the old trees
+  m.front.clear();       // and so did the front's node pairs
 }
 }  // namespace
 

@@ -463,6 +463,7 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     c.cone_policy = parse_cone_policy(o.string("cone_policy", std::string(to_string(c.cone_policy)),
                                                {"provot", "proposed", "exact"}));
     c.cull_min_triangles = o.integer("cull_min_triangles", c.cull_min_triangles);
+    c.reuse_front = o.boolean("reuse_front", c.reuse_front);
     c.affine_zones = o.string("zone_motion", c.affine_zones ? "affine" : "rigid",
                               {"rigid", "affine"}) == "affine";
     s.repair_initial_crossings = o.boolean("repair_initial_crossings", s.repair_initial_crossings);

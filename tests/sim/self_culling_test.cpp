@@ -1,7 +1,8 @@
 // The self CCD's culling and cone policy change what the detector costs, never the motion: a
 // sheet pinned along one edge and swinging onto a sphere (self and body contact) gives the same
 // bytes in every frame with no culling and with the sound culling under each cone policy; the
-// per-frame detector figures follow the settings and do not depend on the thread count.
+// per-frame detector figures follow the settings and do not depend on the thread count. The
+// detectors' traversal front changes nothing either.
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
@@ -19,7 +20,7 @@ namespace {
 constexpr int kFrames = 4;
 
 Scene swinging_sheet(const std::string& culling, const std::string& policy,
-                     int cull_min_triangles = 16) {
+                     int cull_min_triangles = 16, bool reuse_front = false) {
   nlohmann::json j = nlohmann::json::parse(R"({"name": "swing", "frames": 4, "frame_dt": 0.04,
     "cloth": {"grid": {"origin": [-0.3, 0.22, -0.3], "u": [0.6, 0, 0], "v": [0, 0, 0.6],
                        "resolution": [24, 24]}},
@@ -29,6 +30,7 @@ Scene swinging_sheet(const std::string& culling, const std::string& policy,
   j["collisions"]["culling"] = culling;
   j["collisions"]["cone_policy"] = policy;
   j["collisions"]["cull_min_triangles"] = cull_min_triangles;
+  j["collisions"]["reuse_front"] = reuse_front;
   return parse_scene(j, "swing.json");
 }
 
@@ -42,8 +44,8 @@ struct Frames {
 };
 
 Frames run(const std::string& culling, const std::string& policy, int threads = 2,
-           int cull_min_triangles = 16) {
-  Simulation sim(swinging_sheet(culling, policy, cull_min_triangles));
+           int cull_min_triangles = 16, bool reuse_front = false) {
+  Simulation sim(swinging_sheet(culling, policy, cull_min_triangles, reuse_front));
   Frames r;
   tbb::task_arena arena(threads);
   arena.execute([&] {
@@ -111,6 +113,23 @@ TEST(SelfCulling, EverySettingGivesTheSameFramesBitwise) {
     }
     EXPECT_GT(culled, 0) << policy;  // the cones were in the loop
     EXPECT_LT(pairs, pairs_none) << policy;
+  }
+}
+
+// The detectors' traversal front (collisions.reuse_front) changes the traversal's cost only.
+TEST(SelfCulling, TheTraversalFrontGivesTheSameFramesBitwise) {
+  for (const char* culling : {"none", "sound"}) {
+    const Frames plain = run(culling, "proposed"), front = run(culling, "proposed", 2, 16, true);
+    for (int f = 0; f < kFrames; ++f) {
+      const FrameStats &a = plain.frames[f], &b = front.frames[f];
+      ASSERT_TRUE(same_bytes(plain.x[f], front.x[f])) << culling << " frame " << f + 1;
+      ASSERT_TRUE(same_bytes(plain.v[f], front.v[f])) << culling << " frame " << f + 1;
+      EXPECT_EQ(a.ccd_hits, b.ccd_hits) << culling << " frame " << f + 1;
+      EXPECT_EQ(a.self_ccd.calls, b.self_ccd.calls) << culling << " frame " << f + 1;
+      EXPECT_EQ(a.self_ccd.triangle_pairs, b.self_ccd.triangle_pairs)
+          << culling << " frame " << f + 1;
+      EXPECT_EQ(a.self_ccd.nodes_culled, b.self_ccd.nodes_culled) << culling << " frame " << f + 1;
+    }
   }
 }
 

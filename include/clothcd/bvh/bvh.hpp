@@ -107,6 +107,8 @@ class Bvh {
   [[nodiscard]] const std::vector<int>& prim_ids() const { return prim_ids_; }
   /// Node index of the leaf that holds face f.
   [[nodiscard]] int leaf_of_face(int f) const { return leaf_of_face_[f]; }
+  /// Index of a node's parent; -1 for the root.
+  [[nodiscard]] int parent(int node) const { return parent_[node]; }
   /// Node ranges of each depth: level d is [level_offsets()[d], level_offsets()[d + 1]).
   [[nodiscard]] const std::vector<int>& level_offsets() const { return level_offsets_; }
   [[nodiscard]] int depth() const { return static_cast<int>(level_offsets_.size()) - 1; }

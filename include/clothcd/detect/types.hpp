@@ -58,6 +58,14 @@ struct DetectOptions {
   /// are the same at any value, only the culled-node counts change. 0: every node (the paper's
   /// rule).
   int cull_min_triangles = 0;
+  /// A simulator's shortcut, results unchanged: each unrestricted detect() starts its traversal
+  /// where the previous one stopped (its "front" of node pairs: the pairs whose boxes missed and
+  /// the overlapping leaf pairs), not at the root, and keeps the new front for the next call.
+  /// Between successive steps of a slowly moving mesh most of the front stays where it was, and
+  /// the box tests above it are saved. The same triangle pairs reach the narrow phase, so the
+  /// results are the same; the front costs 8 bytes per node pair (DetectStats::front_pairs).
+  /// Restricted calls, proximity queries and detect_each() traverse as without it.
+  bool reuse_front = false;
   /// Optional vertex pairs that count as one point (the two sides of a stitched seam): VF and EE
   /// pairs joining them are not tested, like pairs that share a vertex. Any order; duplicates
   /// allowed.
@@ -75,6 +83,7 @@ struct DetectStats {
   std::uint64_t cone_tests = 0;     ///< internal self tests that evaluated the rule
   std::uint64_t contour_tests = 0;  ///< contour tests run (Sound)
   std::uint64_t contour_fails = 0;  ///< ... of which failed, so the cone could not cull
+  std::uint64_t front_pairs = 0;  ///< node pairs of the front kept for the next call (reuse_front)
   int internal_nodes = 0;
   int connected_internal_nodes = 0;  ///< internal nodes whose triangles are edge-connected
   int disk_internal_nodes = 0;

@@ -96,6 +96,10 @@ struct ContactOptions {
   /// (DetectOptions::cull_min_triangles): a smaller node can save few pair tests and costs about
   /// as much to test. Any value gives the same motion; 0 tests every node.
   int cull_min_triangles = 16;
+  /// The self and cloth-body CCD detectors start each full pass's traversal from the previous
+  /// one's front of node pairs (DetectOptions::reuse_front). The same pairs, so the same motion;
+  /// only the traversal's cost changes (docs/results/front.md).
+  bool reuse_front = false;
 };
 
 /// What the self detector's full CCD passes cost, summed over calls: the passes that test every

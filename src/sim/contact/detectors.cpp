@@ -10,6 +10,7 @@ DetectOptions ccd_detect_options(const ContactOptions& o) {
   d.thickness = o.ccd_thickness;
   d.toi_tolerance = o.toi_tolerance;
   d.distance_filter_depth = o.distance_filter_depth;
+  d.reuse_front = o.reuse_front;
   return d;
 }
 
