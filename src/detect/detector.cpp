@@ -222,15 +222,12 @@ struct SelfDetector::Impl {
     return ok;
   }
 
-  // Overlapping non-adjacent leaf pairs of the culled self traversal, held in `locals` (emptied
-  // first) until the next traversal into them.
-  detail::PairList traverse(Rule mode, DetectStats& st, PairLocals& locals) {
-    const auto& nodes = bvh.nodes();
-    const auto& prims = bvh.prim_ids();
-    auto cull = [&](int i, detail::TraversalCounters& c) { return culls(mode, i, c); };
-    // Plain pointers: the output's stores could otherwise alias the containers.
-    auto leaf = [np = nodes.data(), pp = prims.data(), fp = topo.faces().data()](int a, int b,
-                                                                                 PairBuffer& out) {
+  // The traversals' step at an overlapping leaf pair: its faces' pair, unless they share a
+  // vertex (left to the orphans, only counted). Plain pointers: the output's stores could
+  // otherwise alias the containers.
+  [[nodiscard]] auto leaf_step() const {
+    return [np = bvh.nodes().data(), pp = bvh.prim_ids().data(), fp = topo.faces().data()](
+               int a, int b, PairBuffer& out) {
       const int fa = pp[np[a].first], fb = pp[np[b].first];
       if (faces_touch(fp[fa], fp[fb])) {
         ++out.adjacent;
@@ -238,6 +235,14 @@ struct SelfDetector::Impl {
       }
       out.pairs.push(fa, fb);
     };
+  }
+
+  // Overlapping non-adjacent leaf pairs of the culled self traversal, held in `locals` (emptied
+  // first) until the next traversal into them.
+  detail::PairList traverse(Rule mode, DetectStats& st, PairLocals& locals) {
+    const auto& nodes = bvh.nodes();
+    auto cull = [&](int i, detail::TraversalCounters& c) { return culls(mode, i, c); };
+    const auto leaf = leaf_step();
     std::span<const std::uint8_t> act;
     if (restricted) act = node_active;
     auto tr = detail::make_traversal(nodes, nodes, act, act, cull, leaf);
@@ -301,16 +306,7 @@ struct SelfDetector::Impl {
       }
       front.seed(roots);
     }
-    const auto& prims = bvh.prim_ids();
-    auto leaf = [np = nodes.data(), pp = prims.data(), fp = topo.faces().data()](int a, int b,
-                                                                                 PairBuffer& out) {
-      const int fa = pp[np[a].first], fb = pp[np[b].first];
-      if (faces_touch(fp[fa], fp[fb])) {
-        ++out.adjacent;
-        return;
-      }
-      out.pairs.push(fa, fb);
-    };
+    const auto leaf = leaf_step();
     st.box_tests = front.run(
         bvh, bvh, [&](int n) { return (front_live[n] & 2) != 0; }, leaf, locals);
     detail::TraversalCounters c;
