@@ -240,7 +240,9 @@ TEST(ReuseFront, PairDetectorResultsUnchanged) {
       test::expect_pair_equal(r, r0);
       EXPECT_EQ(r.stats.triangle_pairs, r0.stats.triangle_pairs);
       EXPECT_GT(r.stats.front_pairs, 0u);
-      if (k == 0) EXPECT_EQ(r.stats.box_tests, r0.stats.box_tests);
+      if (k == 0) {
+        EXPECT_EQ(r.stats.box_tests, r0.stats.box_tests);
+      }
       if (k > 0 && k < 12) {
         tests += r.stats.box_tests;
         ref_tests += r0.stats.box_tests;
