@@ -238,26 +238,25 @@ struct SelfDetector::Impl {
   }
 
   // Overlapping non-adjacent leaf pairs of the culled self traversal, held in `locals` (emptied
-  // first) until the next traversal into them.
-  detail::PairList traverse(Rule mode, DetectStats& st, PairLocals& locals) {
-    const auto& nodes = bvh.nodes();
-    auto cull = [&](int i, detail::TraversalCounters& c) { return culls(mode, i, c); };
-    const auto leaf = leaf_step();
-    std::span<const std::uint8_t> act;
-    if (restricted) act = node_active;
-    auto tr = detail::make_traversal(nodes, nodes, act, act, cull, leaf);
+  // first) until the next traversal into them. `from_front` (unrestricted calls only): from the
+  // front of the last call that used one, which it replaces (DetectOptions::reuse_front): the
+  // same leaf pairs and self tests; only the pairs' order and the box tests differ.
+  detail::PairList traverse(Rule mode, DetectStats& st, PairLocals& locals,
+                            bool from_front = false) {
     for (PairBuffer& l : locals) {
       l.pairs.clear();
       l.adjacent = 0;
     }
     detail::PairList pairs;
-    if (nodes.empty()) return pairs;
-    const detail::TraversalCounters c = detail::run_parallel(tr, {0, 0, true}, locals);
+    if (bvh.nodes().empty()) return pairs;
+    const detail::TraversalCounters c =
+        from_front ? traverse_front(mode, locals) : traverse_root(mode, locals);
     st.box_tests = c.box_tests;
     st.nodes_culled = c.culled;
     st.cone_tests = c.cone_tests;
     st.contour_tests = c.contour_tests;
     st.contour_fails = c.contour_fails;
+    st.front_pairs = from_front ? front.size() : 0;
     for (const auto& l : locals) {
       pairs.add(l.pairs);
       st.adjacent_pairs += l.adjacent;
@@ -265,20 +264,22 @@ struct SelfDetector::Impl {
     return pairs;
   }
 
-  // traverse() from the front of the last call that used one (DetectOptions::reuse_front): the
-  // same leaf pairs and self tests; only the pairs' order and the box tests differ. Unrestricted
-  // calls only.
-  detail::PairList traverse_front(Rule mode, DetectStats& st, PairLocals& locals) {
+  // traverse()'s walk from the root, in parallel over a frontier of tasks.
+  detail::TraversalCounters traverse_root(Rule mode, PairLocals& locals) {
     const auto& nodes = bvh.nodes();
-    for (PairBuffer& l : locals) {
-      l.pairs.clear();
-      l.adjacent = 0;
-    }
-    detail::PairList pairs;
-    if (nodes.empty()) return pairs;
-    // The self tests traverse() makes, a level at a time: bit 0 of front_live[n], the self test
-    // of n runs (its parent's did and was not culled); bit 1, n is internal and not culled, so
-    // the pairs of its children are traversed.
+    auto cull = [&](int i, detail::TraversalCounters& c) { return culls(mode, i, c); };
+    std::span<const std::uint8_t> act;
+    if (restricted) act = node_active;
+    auto tr = detail::make_traversal(nodes, nodes, act, act, cull, leaf_step());
+    return detail::run_parallel(tr, {0, 0, true}, locals);
+  }
+
+  // traverse()'s walk from the front: first the self tests the walk from the root makes, a level
+  // at a time (bit 0 of front_live[n]: the self test of n runs, its parent's did and was not
+  // culled; bit 1: n is internal and not culled, so the pairs of its children are traversed),
+  // then the front of every internal node, from its children pair on the first call.
+  detail::TraversalCounters traverse_front(Rule mode, PairLocals& locals) {
+    const auto& nodes = bvh.nodes();
     front_live.assign(nodes.size(), 0);
     front_live[0] = 1;
     tbb::enumerable_thread_specific<detail::TraversalCounters> counters;
@@ -306,22 +307,12 @@ struct SelfDetector::Impl {
       }
       front.seed(roots);
     }
-    const auto leaf = leaf_step();
-    st.box_tests = front.run(
-        bvh, bvh, [&](int n) { return (front_live[n] & 2) != 0; }, leaf, locals);
     detail::TraversalCounters c;
     for (const auto& k : counters)
       c.add(k);
-    st.nodes_culled = c.culled;
-    st.cone_tests = c.cone_tests;
-    st.contour_tests = c.contour_tests;
-    st.contour_fails = c.contour_fails;
-    st.front_pairs = front.size();
-    for (const auto& l : locals) {
-      pairs.add(l.pairs);
-      st.adjacent_pairs += l.adjacent;
-    }
-    return pairs;
+    c.box_tests = front.run(
+        bvh, bvh, [&](int n) { return (front_live[n] & 2) != 0; }, leaf_step(), locals);
+    return c;
   }
 
   [[nodiscard]] detail::FeatureContext ccd_context() const {
@@ -757,10 +748,8 @@ struct SelfDetector::Impl {
     DetectStats& st = res.stats;
     refit(st);
     auto t = Clock::now();
-    if (!opt.reuse_front && !front.empty()) front.clear();
-    const detail::PairList pairs = opt.reuse_front && !restricted
-                                       ? traverse_front(rule(), st, pair_locals)
-                                       : traverse(rule(), st, pair_locals);
+    const detail::PairList pairs =
+        traverse(rule(), st, pair_locals, opt.reuse_front && !restricted);
     st.time_traverse = seconds_since(t);
     t = Clock::now();
     detail::FeatureContext ctx = ccd_context();
@@ -1028,6 +1017,7 @@ void SelfDetector::set_options(const DetectOptions& options) {
   impl_->opt.build = build;
   impl_->links_current = false;
   impl_->reuse.valid = false;
+  if (!options.reuse_front) impl_->front.clear();
 }
 const Topology& SelfDetector::topology() const {
   return impl_->topo;

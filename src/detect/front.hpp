@@ -38,6 +38,10 @@ class TraversalFront {
     int root, a0, b0;
   };
 
+  /// `piece`: the most pairs of one root's front walked as one work item (a longer front is
+  /// split, and two missing siblings on either side of a cut are not merged).
+  explicit TraversalFront(std::uint32_t piece = 4096) : piece_(piece) {}
+
   [[nodiscard]] bool empty() const { return segments_ == 0; }
   /// Node pairs held.
   [[nodiscard]] std::size_t size() const { return size_; }
@@ -67,8 +71,7 @@ class TraversalFront {
   template <class Live, class Leaf, class Local>
   std::uint64_t run(const Bvh& ta, const Bvh& tb, Live&& live, Leaf&& leaf,
                     tbb::enumerable_thread_specific<Local>& locals) {
-    // Work items: each segment of the current front, long ones in pieces (merges stop at their
-    // ends, which costs little).
+    // Work items: each segment of the current front, long ones in pieces.
     struct Item {
       const Arena* arena;
       Segment seg;
@@ -76,10 +79,10 @@ class TraversalFront {
     std::vector<Item> items;
     for (const Arena& a : arenas_[cur_]) {
       for (const Segment& s : a.segs) {
-        for (std::uint32_t k = 0; k < s.count; k += kPiece) {
+        for (std::uint32_t k = 0; k < s.count; k += piece_) {
           Segment part = s;
           part.begin = s.begin + k;
-          part.count = std::min<std::uint32_t>(kPiece, s.count - k);
+          part.count = std::min<std::uint32_t>(piece_, s.count - k);
           part.head = s.head && k == 0;
           items.push_back({&a, part});
         }
@@ -89,7 +92,7 @@ class TraversalFront {
     for (Arena& a : arenas_[next])
       a.clear();
     tbb::enumerable_thread_specific<std::uint64_t> tests(0);
-    const Walk walk{ta.nodes().data(), tb.nodes().data(), &ta, &tb};
+    const Walk walk{ta, tb};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, items.size(), 16),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         Arena& out = arenas_[next].local();
@@ -102,7 +105,7 @@ class TraversalFront {
                           Segment seg = it.seg;
                           seg.begin = static_cast<std::uint32_t>(out.pairs.size());
                           if (live(seg.root.root)) {
-                            walk.run(seg, in, out, count, [&](int x, int y) { leaf(x, y, local); });
+                            walk.run(in, out, count, [&](int x, int y) { leaf(x, y, local); });
                           } else if (seg.head) {
                             out.pairs.push_back({seg.root.a0, seg.root.b0});
                           }
@@ -143,21 +146,20 @@ class TraversalFront {
       segs.clear();
     }
   };
-  static constexpr std::uint32_t kPiece = 4096;
   static constexpr std::size_t kAhead = 8;
 
   // The traversal below a segment's pairs.
   struct Walk {
-    const BvhNode* xa;
-    const BvhNode* xb;
-    const Bvh* ta;
-    const Bvh* tb;
+    const Bvh& ta;
+    const Bvh& tb;
 
-    // Appends the new front of `in` (root seg.root) to out.pairs: each pair traversed as
-    // Traversal::step does, in DFS order, its stops appended, and adjacent missing siblings merged.
+    // Appends the new front of `in` (pairs of one root's front) to out.pairs: each pair traversed
+    // as Traversal::step does (splits_first), in DFS order, its stops appended, and adjacent
+    // missing siblings merged.
     template <class Leaf>
-    void run(const Segment& seg, std::span<const NodePair> in, Arena& out, std::uint64_t& tests,
-             Leaf&& leaf) const {
+    void run(std::span<const NodePair> in, Arena& out, std::uint64_t& tests, Leaf&& leaf) const {
+      const BvhNode* const xa = ta.nodes().data();
+      const BvhNode* const xb = tb.nodes().data();
       const std::size_t base = out.pairs.size();
       out.miss.resize(base);
       // A stop: kept, then merged with the stops before it while the pair above both misses. Only
@@ -166,12 +168,12 @@ class TraversalFront {
         while (merge && missed && out.pairs.size() > base && out.miss.back() != 0) {
           const NodePair q = out.pairs.back();  // before p in DFS order
           NodePair up;
-          if (q.b == p.b && q.a != p.a && q.a != seg.root.a0 &&
-              ta->parent(q.a) == ta->parent(p.a)) {
-            up = {ta->parent(q.a), q.b};
-          } else if (q.a == p.a && q.b != p.b && q.b != seg.root.b0 &&
-                     tb->parent(q.b) == tb->parent(p.b)) {
-            up = {q.a, tb->parent(q.b)};
+          // Siblings q.a, p.a both lie below the root pair's a0 (every pair of a root's front
+          // does), so their parent does too: a merge never leaves the root pair (likewise b).
+          if (q.b == p.b && q.a != p.a && ta.parent(q.a) == ta.parent(p.a)) {
+            up = {ta.parent(q.a), q.b};
+          } else if (q.a == p.a && q.b != p.b && tb.parent(q.b) == tb.parent(p.b)) {
+            up = {q.a, tb.parent(q.b)};
           } else {
             break;
           }
@@ -205,10 +207,8 @@ class TraversalFront {
             leaf(t.a, t.b);
             stop(t, false, false);
           } else {
-            // Traversal::step's split: the larger node (the inner one against a leaf).
-            const bool split_a = y.is_leaf() || (!x.is_leaf() && x.count >= y.count);
             if (top == kStackSize) stack_overflow();
-            if (split_a) {
+            if (splits_first(x, y)) {
               stack[top++] = {x.left + 1, t.b};
               t = {x.left, t.b};
             } else {
@@ -225,6 +225,7 @@ class TraversalFront {
   };
 
   tbb::enumerable_thread_specific<Arena> arenas_[2];
+  std::uint32_t piece_;
   int cur_ = 0;
   std::size_t segments_ = 0, size_ = 0;
 };

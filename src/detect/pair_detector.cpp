@@ -231,34 +231,30 @@ struct PairDetector::Impl {
     if (na.empty() || nb.empty()) return pairs;
     const auto& pa = a.bvh.prim_ids();
     const auto& pb = b.bvh.prim_ids();
+    auto leaf = [&](int x, int y, Pairs& out) {
+      out.v.emplace_back(pa[na[x].first], pb[nb[y].first]);
+    };
+    for (auto& l : pair_locals)
+      l.v.clear();
     if (from_front) {
-      for (auto& l : pair_locals)
-        l.v.clear();
       if (front.empty()) {
         const detail::TraversalFront::Root root{0, 0, 0};
         front.seed({&root, 1});
       }
       st.box_tests = front.run(
-          a.bvh, b.bvh, [](int) { return true; },
-          [&](int x, int y, Pairs& out) { out.v.emplace_back(pa[na[x].first], pb[nb[y].first]); },
-          pair_locals);
+          a.bvh, b.bvh, [](int) { return true; }, leaf, pair_locals);
       st.front_pairs = front.size();
-      for (const auto& l : pair_locals)
-        pairs.insert(pairs.end(), l.v.begin(), l.v.end());
-      return pairs;
+    } else {
+      std::span<const std::uint8_t> act_a, act_b;
+      if (restricted) {
+        act_a = a.node_active;
+        act_b = b.node_active;
+      }
+      auto tr = detail::make_traversal(
+          std::span<const BvhNode>(na), std::span<const BvhNode>(nb), act_a, act_b,
+          [](int, detail::TraversalCounters&) { return false; }, leaf);
+      st.box_tests = detail::run_parallel(tr, {0, 0, false}, pair_locals).box_tests;
     }
-    std::span<const std::uint8_t> act_a, act_b;
-    if (restricted) {
-      act_a = a.node_active;
-      act_b = b.node_active;
-    }
-    auto tr = detail::make_traversal(
-        std::span<const BvhNode>(na), std::span<const BvhNode>(nb), act_a, act_b,
-        [](int, detail::TraversalCounters&) { return false; },
-        [&](int x, int y, Pairs& out) { out.v.emplace_back(pa[na[x].first], pb[nb[y].first]); });
-    for (auto& l : pair_locals)
-      l.v.clear();
-    st.box_tests = detail::run_parallel(tr, {0, 0, false}, pair_locals).box_tests;
     for (const auto& l : pair_locals)
       pairs.insert(pairs.end(), l.v.begin(), l.v.end());
     return pairs;
@@ -278,7 +274,6 @@ struct PairDetector::Impl {
 
     t = Clock::now();
     DetectStats st;
-    if (!opt.reuse_front && !front.empty()) front.clear();
     const auto& pairs = traverse(st, opt.reuse_front && !restricted);
     const double t_trav = seconds_since(t);
 
@@ -504,6 +499,7 @@ void PairDetector::set_options(const DetectOptions& options) {
   const BvhBuild build = impl_->opt.build;
   impl_->opt = options;
   impl_->opt.build = build;
+  if (!options.reuse_front) impl_->front.clear();
 }
 const Topology& PairDetector::topology_a() const {
   return impl_->a.topo;

@@ -48,6 +48,13 @@ inline constexpr int kStackSize = 1024;
                           " pending node pairs (a tree deeper than the builds make)");
 }
 
+/// Which node of an overlapping pair (x, y), not both leaves, a pair traversal splits: x (true)
+/// when it is the larger, or y is a leaf. Every pair traversal splits by this rule, so that they
+/// all walk the same node pairs.
+[[nodiscard]] inline bool splits_first(const BvhNode& x, const BvhNode& y) {
+  return y.is_leaf() || (!x.is_leaf() && x.count >= y.count);
+}
+
 /// Runs one task: `cull(node, counters)` decides self skips, `leaf(a, b)` receives overlapping
 /// leaf pairs, `active_a/b` (optional, per node) prune subtrees without active triangles.
 template <class Cull, class Leaf>
@@ -87,8 +94,7 @@ struct Traversal {
       leaf(t.a, t.b, local);
       return;
     }
-    const bool split_a = y.is_leaf() || (!x.is_leaf() && x.count >= y.count);
-    if (split_a) {
+    if (splits_first(x, y)) {
       push(Task{x.left + 1, t.b, false});
       push(Task{x.left, t.b, false});
     } else {
@@ -154,7 +160,7 @@ struct Traversal {
         const BvhNode& y = xb[t.b];
         if (x.is_leaf() && y.is_leaf()) {
           leaf(t.a, t.b, local);
-        } else if (y.is_leaf() || (!x.is_leaf() && x.count >= y.count)) {
+        } else if (splits_first(x, y)) {
           const int l = x.left;
           const bool hit0 = admit(l, t.b, xa[l], y);
           const bool hit1 = admit(l + 1, t.b, xa[l + 1], y);

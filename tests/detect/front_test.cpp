@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
+#include <random>
 #include <vector>
 
 #include "api_scenes.hpp"
@@ -59,7 +61,10 @@ struct FrontRun {
   std::uint64_t tests = 0;
 };
 
-FrontRun run_front(detail::TraversalFront& front, const Bvh& bvh) {
+// `live(n)`: whether internal node n's children pair is traversed this run.
+FrontRun run_front(
+    detail::TraversalFront& front, const Bvh& bvh,
+    const std::function<bool(int)>& live = [](int) { return true; }) {
   const auto& nodes = bvh.nodes();
   if (front.empty()) {
     std::vector<detail::TraversalFront::Root> roots;
@@ -72,7 +77,7 @@ FrontRun run_front(detail::TraversalFront& front, const Bvh& bvh) {
   const auto& prims = bvh.prim_ids();
   FrontRun r;
   r.tests = front.run(
-      bvh, bvh, [](int) { return true; },
+      bvh, bvh, live,
       [&](int a, int b, Pairs& out) {
         out.emplace_back(prims[nodes[a].first], prims[nodes[b].first]);
       },
@@ -113,6 +118,58 @@ TEST(TraversalFront, SameLeafPairsAsTheFullTraversal) {
         EXPECT_EQ(front.size(), fresh.size()) << s.name << " step " << k;
       }
       EXPECT_GT(stops_before_spread, 0u);
+    }
+  }
+}
+
+// The overlapping leaf pairs (faces, sorted) of the children pairs of the internal nodes with
+// live(n), by testing every leaf of one child against every leaf of the other.
+Pairs brute_force_leaf_pairs(const Bvh& bvh, const std::function<bool(int)>& live) {
+  const auto& nodes = bvh.nodes();
+  const auto& prims = bvh.prim_ids();
+  Pairs out;
+  for (int n = 0; n < static_cast<int>(nodes.size()); ++n) {
+    if (nodes[n].is_leaf() || !live(n)) continue;
+    const BvhNode& l = nodes[nodes[n].left];
+    const BvhNode& r = nodes[nodes[n].left + 1];
+    for (int i = l.first; i < l.first + l.count; ++i) {
+      for (int j = r.first; j < r.first + r.count; ++j) {
+        const int fa = prims[i], fb = prims[j];
+        if (overlap(nodes[bvh.leaf_of_face(fa)], nodes[bvh.leaf_of_face(fb)])) {
+          out.emplace_back(fa, fb);
+        }
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Roots left out of a run (as a culled node's are) go back to their children pair; the roots
+// traversed give exactly the overlapping leaf pairs below them, whatever was left out before;
+// also with every root's front cut into pieces of 3 pairs (several segments per root).
+TEST(TraversalFront, RootsLeftOutStartAgainFromTheirChildrenPair) {
+  for (const auto& s : front_scenes()) {
+    for (std::uint32_t piece : {4096u, 3u}) {
+      const Topology topo(s.faces, s.num_vertices);
+      Bvh bvh(topo, points(s.v_t0), BvhBuild::Patch);
+      detail::TraversalFront front(piece);
+      std::mt19937 rng(5);
+      const auto steps = front_steps(s);
+      for (std::size_t k = 0; k < steps.size(); ++k) {
+        bvh.refit(points(steps[k].first), points(steps[k].second), RefitOptions{});
+        // Each internal node traversed with probability 0.6 (every one at the last step).
+        std::vector<std::uint8_t> on(bvh.nodes().size());
+        for (auto& x : on)
+          x = k + 1 == steps.size() || rng() % 5 < 3;
+        const auto live = [&](int n) { return on[n] != 0; };
+        const FrontRun a = run_front(front, bvh, live);
+        EXPECT_EQ(a.pairs, brute_force_leaf_pairs(bvh, live)) << s.name << " step " << k;
+        EXPECT_GT(a.pairs.size(), 0u) << s.name << " piece " << piece << " step " << k;
+      }
+      Pairs all = overlapping_leaf_pairs(bvh);
+      std::sort(all.begin(), all.end());
+      EXPECT_EQ(run_front(front, bvh).pairs, all) << s.name;
     }
   }
 }
