@@ -89,8 +89,8 @@ void record_before(const TriangleMesh& mesh, SewingReport& report) {
   report.nonmanifold_edges_before = topo.num_nonmanifold_edges();
 }
 
-void record_after(SewnMesh& out) {
-  const Topology topo(out.mesh.faces, out.mesh.num_vertices());
+// `topo`: the topology of out.mesh.
+void record_after(SewnMesh& out, const Topology& topo) {
   out.report.components_after = topo.num_components();
   out.report.boundary_edges_after = topo.num_boundary_edges();
   out.report.nonmanifold_edges_after = topo.num_nonmanifold_edges();
@@ -209,9 +209,10 @@ SewnMesh weld_only(const TriangleMesh& mesh, double tolerance) {
   return apply_clusters(mesh, parent);
 }
 
-// One round of T-junction detection on the current mesh; returns the number of inserts.
-int find_t_junctions(const TriangleMesh& mesh, double tolerance, Inserts& inserts) {
-  const Topology topo(mesh.faces, mesh.num_vertices());
+// One round of T-junction detection on the current mesh, whose topology is `topo`; returns the
+// number of inserts.
+int find_t_junctions(const TriangleMesh& mesh, const Topology& topo, double tolerance,
+                     Inserts& inserts) {
   std::vector<int> boundary;
   std::vector<char> on_boundary(static_cast<std::size_t>(mesh.num_vertices()), 0);
   double longest = tolerance;
@@ -265,32 +266,42 @@ int find_t_junctions(const TriangleMesh& mesh, double tolerance, Inserts& insert
   return count;
 }
 
-}  // namespace
-
-SewnMesh weld(const TriangleMesh& mesh, double tolerance) {
+// weld_only, with the report's counts of the input mesh filled in.
+SewnMesh weld_reporting_before(const TriangleMesh& mesh, double tolerance) {
   SewingReport before;
   record_before(mesh, before);
   SewnMesh out = weld_only(mesh, tolerance);
   out.report.components_before = before.components_before;
   out.report.boundary_edges_before = before.boundary_edges_before;
   out.report.nonmanifold_edges_before = before.nonmanifold_edges_before;
-  record_after(out);
+  return out;
+}
+
+}  // namespace
+
+SewnMesh weld(const TriangleMesh& mesh, double tolerance) {
+  SewnMesh out = weld_reporting_before(mesh, tolerance);
+  record_after(out, Topology(out.mesh.faces, out.mesh.num_vertices()));
   return out;
 }
 
 SewnMesh sew(const TriangleMesh& mesh, double tolerance) {
-  SewnMesh out = weld(mesh, tolerance);
+  SewnMesh out = weld_reporting_before(mesh, tolerance);
   // Each round inserts vertices into edges; a vertex, once inserted, is an endpoint of the
   // pieces, so rounds stop quickly. The cap only guards against a pathological input.
   constexpr int kMaxRounds = 64;
   for (int round = 0; round < kMaxRounds; ++round) {
+    const Topology topo(out.mesh.faces, out.mesh.num_vertices());
     Inserts inserts;
-    const int n = find_t_junctions(out.mesh, tolerance, inserts);
-    if (n == 0) break;
+    const int n = find_t_junctions(out.mesh, topo, tolerance, inserts);
+    if (n == 0) {
+      record_after(out, topo);
+      return out;
+    }
     out.mesh.faces = split_faces(out.mesh.faces, inserts);
     out.report.edges_split += n;
   }
-  record_after(out);
+  record_after(out, Topology(out.mesh.faces, out.mesh.num_vertices()));
   return out;
 }
 
@@ -353,7 +364,7 @@ SewnMesh sew_stitches(const TriangleMesh& mesh, std::span<const Stitch> stitches
   }
   out.mesh.faces = split_faces(out.mesh.faces, inserts);
   out.report.edges_split = splits;
-  record_after(out);
+  record_after(out, Topology(out.mesh.faces, out.mesh.num_vertices()));
   return out;
 }
 

@@ -13,32 +13,6 @@
 namespace clothcd {
 namespace {
 
-void validate_faces(const std::vector<Face>& faces, int num_vertices) {
-  if (num_vertices < 0) {
-    throw InputError(fmt::format("topology: vertex count {} is negative", num_vertices));
-  }
-  // 3 * faces must fit an int (half-edge ids below).
-  if (faces.size() > static_cast<std::size_t>(std::numeric_limits<int>::max() / 3)) {
-    throw InputError(fmt::format("topology: {} faces exceed the supported maximum of {}",
-                                 faces.size(), std::numeric_limits<int>::max() / 3));
-  }
-  for (std::size_t f = 0; f < faces.size(); ++f) {
-    const Face& t = faces[f];
-    for (int k = 0; k < 3; ++k) {
-      if (t[k] < 0 || t[k] >= num_vertices) {
-        throw InputError(fmt::format(
-            "face {} ({}, {}, {}): vertex index {} is out of range, expected 0 <= index < {}", f,
-            t[0], t[1], t[2], t[k], num_vertices));
-      }
-    }
-    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
-      throw InputError(fmt::format(
-          "face {} ({}, {}, {}) repeats a vertex, expected three distinct vertex indices", f, t[0],
-          t[1], t[2]));
-    }
-  }
-}
-
 // Counting sort of (key, value) pairs into CSR arrays; values keep their input order per key.
 template <class Emit>
 void build_csr(int num_keys, std::size_t num_items, Emit emit, std::vector<int>& offsets,
@@ -60,6 +34,32 @@ int find_root(std::vector<int>& parent, int x) {
 }
 
 }  // namespace
+
+void validate_faces(std::span<const Face> faces, int num_vertices) {
+  if (num_vertices < 0) {
+    throw InputError(fmt::format("topology: vertex count {} is negative", num_vertices));
+  }
+  // 3 * faces must fit an int (a Topology numbers the half-edges with ints).
+  if (faces.size() > static_cast<std::size_t>(std::numeric_limits<int>::max() / 3)) {
+    throw InputError(fmt::format("topology: {} faces exceed the supported maximum of {}",
+                                 faces.size(), std::numeric_limits<int>::max() / 3));
+  }
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const Face& t = faces[f];
+    for (int k = 0; k < 3; ++k) {
+      if (t[k] < 0 || t[k] >= num_vertices) {
+        throw InputError(fmt::format(
+            "face {} ({}, {}, {}): vertex index {} is out of range, expected 0 <= index < {}", f,
+            t[0], t[1], t[2], t[k], num_vertices));
+      }
+    }
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      throw InputError(fmt::format(
+          "face {} ({}, {}, {}) repeats a vertex, expected three distinct vertex indices", f, t[0],
+          t[1], t[2]));
+    }
+  }
+}
 
 Topology::Topology(std::vector<Face> faces, int num_vertices)
     : num_vertices_(num_vertices), faces_(std::move(faces)) {
@@ -158,16 +158,16 @@ Topology::Topology(std::vector<Face> faces, int num_vertices)
   }
 
   // Duplicates: faces with the same vertex set as an earlier face, whatever their orientation.
-  {
-    std::vector<std::pair<Face, int>> sorted(static_cast<std::size_t>(nf));
-    for (int f = 0; f < nf; ++f) {
-      Face t = faces_[f];
-      std::sort(t.begin(), t.end());
-      sorted[f] = {t, f};
-    }
-    std::sort(sorted.begin(), sorted.end());
-    for (std::size_t i = 1; i < sorted.size(); ++i) {
-      if (sorted[i].first == sorted[i - 1].first) ++num_duplicate_faces_;
+  // Such a face g holds f's first edge, so it is among that edge's faces, and holds f's third
+  // corner too.
+  for (int f = 0; f < nf; ++f) {
+    const Face& t = faces_[f];
+    for (int g : edge_faces(face_edges_[f][0])) {
+      const Face& u = faces_[g];
+      if (g < f && (u[0] == t[2] || u[1] == t[2] || u[2] == t[2])) {
+        ++num_duplicate_faces_;
+        break;
+      }
     }
   }
 
@@ -188,24 +188,6 @@ Topology::Topology(std::vector<Face> faces, int num_vertices)
     if (root_component[r] < 0) root_component[r] = num_components_++;
     face_component_[f] = root_component[r];
   }
-}
-
-std::span<const int> Topology::edge_faces(int e) const {
-  assert(e >= 0 && e < num_edges());
-  return {edge_face_ids_.data() + edge_face_offsets_[e],
-          static_cast<std::size_t>(edge_face_offsets_[e + 1] - edge_face_offsets_[e])};
-}
-
-std::span<const int> Topology::vertex_faces(int v) const {
-  assert(v >= 0 && v < num_vertices());
-  return {vertex_face_ids_.data() + vertex_face_offsets_[v],
-          static_cast<std::size_t>(vertex_face_offsets_[v + 1] - vertex_face_offsets_[v])};
-}
-
-std::span<const int> Topology::vertex_edges(int v) const {
-  assert(v >= 0 && v < num_vertices());
-  return {vertex_edge_ids_.data() + vertex_edge_offsets_[v],
-          static_cast<std::size_t>(vertex_edge_offsets_[v + 1] - vertex_edge_offsets_[v])};
 }
 
 int Topology::find_edge(int a, int b) const {

@@ -45,7 +45,7 @@ void validate_mesh(const TriangleMesh& mesh, std::string_view what) {
     }
   }
   try {
-    const Topology topology(mesh.faces, mesh.num_vertices());
+    validate_faces(mesh.faces, mesh.num_vertices());
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", what, e.what()));
   }

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cassert>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -18,6 +19,10 @@ using Edge = std::array<int, 2>;  ///< (smaller vertex id, larger vertex id)
 /// Rows of an m x 3 integer matrix (libigl's F) as faces; ids are checked where a Topology is
 /// made.
 [[nodiscard]] std::vector<Face> to_faces(const Eigen::Ref<const Eigen::MatrixX3i>& faces);
+
+/// The checks a Topology makes of its input, without building it: throws clothcd::InputError
+/// naming the face for a vertex index outside [0, num_vertices) or a face repeating a vertex.
+void validate_faces(std::span<const Face> faces, int num_vertices);
 
 /// Validated topology. Construction throws clothcd::InputError naming the face and what is wrong
 /// for an index out of range or a face that repeats a vertex. Duplicate faces and non-manifold
@@ -39,11 +44,17 @@ class Topology {
   /// Edge ids of face f: edge k joins faces()[f][k] and faces()[f][(k + 1) % 3].
   [[nodiscard]] const std::array<int, 3>& face_edges(int f) const { return face_edges_[f]; }
   /// Faces incident to edge e (1 on a boundary, 2 inside, more when non-manifold).
-  [[nodiscard]] std::span<const int> edge_faces(int e) const;
+  [[nodiscard]] std::span<const int> edge_faces(int e) const {
+    return csr_row(edge_face_offsets_, edge_face_ids_, e);
+  }
   /// Faces incident to vertex v, ascending.
-  [[nodiscard]] std::span<const int> vertex_faces(int v) const;
+  [[nodiscard]] std::span<const int> vertex_faces(int v) const {
+    return csr_row(vertex_face_offsets_, vertex_face_ids_, v);
+  }
   /// Edges incident to vertex v, ascending.
-  [[nodiscard]] std::span<const int> vertex_edges(int v) const;
+  [[nodiscard]] std::span<const int> vertex_edges(int v) const {
+    return csr_row(vertex_edge_offsets_, vertex_edge_ids_, v);
+  }
   /// Id of the edge joining a and b, or -1.
   [[nodiscard]] int find_edge(int a, int b) const;
 
@@ -70,6 +81,13 @@ class Topology {
   [[nodiscard]] int num_isolated_vertices() const { return num_isolated_vertices_; }
 
  private:
+  // Row i of a compressed sparse row table (inline: the setup's searches call these per feature).
+  static std::span<const int> csr_row(const std::vector<int>& offsets, const std::vector<int>& ids,
+                                      int i) {
+    assert(i >= 0 && i + 1 < static_cast<int>(offsets.size()));
+    return {ids.data() + offsets[i], static_cast<std::size_t>(offsets[i + 1] - offsets[i])};
+  }
+
   int num_vertices_ = 0;
   std::vector<Face> faces_;
   std::vector<Edge> edges_;
