@@ -576,19 +576,24 @@ inline std::pair<int, int> ee_representative(const Topology& topo, int ea, int e
   return {-1, -1};
 }
 
-/// The same R-triangle ownership answers as vf_representative / ee_representative, over flat
-/// copies of the adjacency (no out-of-line calls in the narrow phase's hot loop), for a triangle
-/// pair (f, g) that shares no vertex (the traversal drops the others).
+/// The same R-triangle ownership answers as vf_representative / ee_representative, from per-face
+/// and per-edge records and the topology's inline adjacency (no out-of-line calls in the narrow
+/// phase's hot loop), for a triangle pair (f, g) that shares no vertex (the traversal drops the
+/// others).
 class Ownership {
  public:
   Ownership() = default;
-  explicit Ownership(const Topology& topo) : faces_(topo.faces().data()) {
-    flatten(
-        topo.num_vertices(), [&](int v) { return topo.vertex_faces(v); }, vf_off_, vf_ids_);
-    flatten(
-        topo.num_edges(), [&](int e) { return topo.edge_faces(e); }, ef_off_, ef_ids_);
+  /// Keeps a pointer to `topo`, which must outlive it.
+  explicit Ownership(const Topology& topo) : topo_(&topo), faces_(topo.faces().data()) {
+    // Every edge's and every face's record depends on the topology alone: filled in parallel.
+    const auto for_each = [](int n, auto&& fn) {
+      tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
+        for (int i = r.begin(); i != r.end(); ++i)
+          fn(i);
+      });
+    };
     pair_.resize(topo.num_edges());
-    for (int e = 0; e < topo.num_edges(); ++e) {
+    for_each(topo.num_edges(), [&](int e) {
       const auto fs = topo.edge_faces(e);
       EdgeFaces& r = pair_[e];
       r.general = fs.size() > 2;
@@ -596,9 +601,9 @@ class Ownership {
         r.f[i] = i < fs.size() ? fs[i] : -1;
         r.t[i] = i < fs.size() ? topo.faces()[fs[i]] : Face{-1, -1, -1};
       }
-    }
+    });
     records_.resize(topo.num_faces());
-    for (int f = 0; f < topo.num_faces(); ++f) {
+    for_each(topo.num_faces(), [&](int f) {
       FaceRecord& r = records_[f];
       r.v = topo.faces()[f];
       r.e = topo.face_edges(f);
@@ -618,7 +623,7 @@ class Ownership {
           if (x != d[0] && x != d[1]) r.apex[k] = x;
         }
       }
-    }
+    });
   }
 
   /// One triangle's corners, edges and first-face data side by side (one cache line), so that the
@@ -650,8 +655,7 @@ class Ownership {
   /// v before it touches g.
   [[nodiscard]] bool owns_vf(int v, int g, int f) const {
     const Face& tg = faces_[g];
-    for (int i = vf_off_[v]; i < vf_off_[v + 1]; ++i) {
-      const int h = vf_ids_[i];
+    for (int h : topo_->vertex_faces(v)) {
       if (h == f) return true;
       if (!share_vertex(faces_[h], tg)) return false;
     }
@@ -684,10 +688,8 @@ class Ownership {
   };
 
   [[nodiscard]] bool owns_ee_general(int e1, int e2, int x, int y) const {
-    for (int i = ef_off_[e1]; i < ef_off_[e1 + 1]; ++i) {
-      const int fa = ef_ids_[i];
-      for (int j = ef_off_[e2]; j < ef_off_[e2 + 1]; ++j) {
-        const int fb = ef_ids_[j];
+    for (int fa : topo_->edge_faces(e1)) {
+      for (int fb : topo_->edge_faces(e2)) {
         if (fa == x && fb == y) return true;
         if (!share_vertex(faces_[fa], faces_[fb])) return false;
       }
@@ -695,19 +697,8 @@ class Ownership {
     return false;
   }
 
-  template <class Get>
-  static void flatten(int n, Get&& get, std::vector<int>& off, std::vector<int>& ids) {
-    off.assign(n + 1, 0);
-    ids.clear();
-    for (int i = 0; i < n; ++i) {
-      const auto span = get(i);
-      ids.insert(ids.end(), span.begin(), span.end());
-      off[i + 1] = static_cast<int>(ids.size());
-    }
-  }
-
+  const Topology* topo_ = nullptr;
   const Face* faces_ = nullptr;
-  std::vector<int> vf_off_, vf_ids_, ef_off_, ef_ids_;
   std::vector<EdgeFaces> pair_;
   std::vector<FaceRecord> records_;
 };
