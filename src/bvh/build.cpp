@@ -1,7 +1,10 @@
 // BVH construction: spatial median splits or edge-connected patch splits, then a breadth-first
 // relayout so each depth is one contiguous range of nodes.
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
+#include <atomic>
 #include <numeric>
 #include <queue>
 #include <stdexcept>
@@ -39,31 +42,73 @@ class Builder {
     in_set_.assign(nf, -1);
     in_a_.assign(nf, -1);
     seen_.assign(nf, -1);
+    if (build == BvhBuild::Patch) {
+      // Each face's edge neighbours side by side: the patch splits walk them at every level.
+      neighbour_offsets_.assign(nf + 1, 0);
+      for (int f = 0; f < nf; ++f) {
+        for (int e : topo.face_edges(f))
+          neighbour_offsets_[f + 1] += static_cast<int>(topo.edge_faces(e).size()) - 1;
+      }
+      std::partial_sum(neighbour_offsets_.begin(), neighbour_offsets_.end(),
+                       neighbour_offsets_.begin());
+      neighbours_.resize(neighbour_offsets_[nf]);
+      for (int f = 0, k = 0; f < nf; ++f) {
+        for (int e : topo.face_edges(f)) {
+          for (int g : topo.edge_faces(e)) {
+            if (g != f) neighbours_[k++] = g;
+          }
+        }
+      }
+    }
   }
 
+  // The nodes in depth-first order (a node, its left subtree, its right subtree). A subtree over
+  // c faces has 2 c - 1 nodes, so each node's index follows from the sizes alone: the two
+  // subtrees of a split are built in parallel and the tree is the same whatever the threads.
   std::vector<TmpNode> run() {
-    nodes_.reserve(2 * perm_.size());
-    if (!perm_.empty()) split(0, static_cast<int>(perm_.size()), 0);
+    const int n = static_cast<int>(perm_.size());
+    nodes_.assign(n > 0 ? 2 * static_cast<std::size_t>(n) - 1 : 0, TmpNode{});
+    if (n > 0) split(0, n, 0, 0);
     return std::move(nodes_);
   }
   std::vector<int>& perm() { return perm_; }
 
  private:
-  int split(int first, int count, int depth) {
-    const int id = static_cast<int>(nodes_.size());
-    nodes_.push_back({first, count, -1, -1});
-    if (count == 1) return id;
+  // Subtrees over fewer faces are built by the thread that split their parent.
+  static constexpr int kParallelFaces = 2048;
+
+  void split(int first, int count, int depth, int id) {
+    nodes_[id] = {first, count, -1, -1};
+    if (count == 1) return;
     int mid = 0;
     if (build_ == BvhBuild::Patch && depth < kMaxPatchDepth) {
       mid = patch_split(first, count);
     } else {
       mid = median_split(first, count);
     }
-    const int l = split(first, mid, depth + 1);
-    const int r = split(first + mid, count - mid, depth + 1);
+    const int l = id + 1, r = id + 2 * mid;
     nodes_[id].left = l;
     nodes_[id].right = r;
-    return id;
+    const auto left = [&] { split(first, mid, depth + 1, l); };
+    const auto right = [&] { split(first + mid, count - mid, depth + 1, r); };
+    if (count >= kParallelFaces) {
+      tbb::parallel_invoke(left, right);
+    } else {
+      left();
+      right();
+    }
+  }
+
+  // A stamp no other call has used (concurrent splits mark their own faces with their own).
+  int new_stamp() { return next_stamp_.fetch_add(1, std::memory_order_relaxed); }
+
+  // Whether face g is marked with `stamp` as in the current set. Relaxed atomic: a concurrent
+  // split may be marking g, which is then in its set and never carries this stamp.
+  bool in_set(int g, int stamp) {
+    return std::atomic_ref<int>(in_set_[g]).load(std::memory_order_relaxed) == stamp;
+  }
+  void mark_set(int g, int stamp) {
+    std::atomic_ref<int>(in_set_[g]).store(stamp, std::memory_order_relaxed);
   }
 
   int longest_axis(int first, int count) const {
@@ -91,29 +136,30 @@ class Builder {
     return mid;
   }
 
+  // fn(g) for the faces g sharing an edge with f in the set marked `stamp`, in the order of f's
+  // edges and of each edge's faces (a face sharing two edges with f comes twice).
   template <class Fn>
-  void for_each_neighbour(int f, Fn&& fn) const {
-    for (int e : topo_.face_edges(f)) {
-      for (int g : topo_.edge_faces(e)) {
-        if (g != f && in_set_[g] == stamp_) fn(g);
-      }
+  void for_each_neighbour(int f, int stamp, Fn&& fn) {
+    for (int k = neighbour_offsets_[f]; k < neighbour_offsets_[f + 1]; ++k) {
+      const int g = neighbours_[k];
+      if (in_set(g, stamp)) fn(g);
     }
   }
 
-  // Edge-connected components of the faces in the current set (marked in_set_ == stamp_).
-  std::vector<std::vector<int>> components(std::span<const int> faces) {
+  // Edge-connected components of `faces`, the set marked `stamp`.
+  std::vector<std::vector<int>> components(std::span<const int> faces, int stamp) {
     std::vector<std::vector<int>> comps;
-    ++seen_stamp_;
+    const int seen = new_stamp();
     for (int s : faces) {
-      if (seen_[s] == seen_stamp_) continue;
+      if (seen_[s] == seen) continue;
       comps.emplace_back();
       auto& c = comps.back();
-      seen_[s] = seen_stamp_;
+      seen_[s] = seen;
       c.push_back(s);
       for (std::size_t k = 0; k < c.size(); ++k) {
-        for_each_neighbour(c[k], [&](int g) {
-          if (seen_[g] != seen_stamp_) {
-            seen_[g] = seen_stamp_;
+        for_each_neighbour(c[k], stamp, [&](int g) {
+          if (seen_[g] != seen) {
+            seen_[g] = seen;
             c.push_back(g);
           }
         });
@@ -126,11 +172,11 @@ class Builder {
   // first. Disconnected sets are split between whole components (grouped along the longest axis);
   // a connected set is split into two connected halves grown from one end of its longest axis.
   int patch_split(int first, int count) {
-    ++stamp_;
+    const int stamp = new_stamp();
     std::span<int> faces(perm_.data() + first, count);
     for (int f : faces)
-      in_set_[f] = stamp_;
-    auto comps = components(faces);
+      mark_set(f, stamp);
+    auto comps = components(faces, stamp);
     std::vector<int> a, b;
     if (comps.size() > 1) {
       const int axis = longest_axis(first, count);
@@ -157,7 +203,7 @@ class Builder {
           b.push_back(f);
       }
     } else {
-      grow_halves(faces, a, b);
+      grow_halves(faces, stamp, a, b);
       if (a.empty() || b.empty()) return median_split(first, count);
     }
     std::copy(a.begin(), a.end(), faces.begin());
@@ -165,7 +211,8 @@ class Builder {
     return static_cast<int>(a.size());
   }
 
-  void grow_halves(std::span<int> faces, std::vector<int>& a, std::vector<int>& b) {
+  // `faces`: a connected set, marked `stamp`.
+  void grow_halves(std::span<int> faces, int stamp, std::vector<int>& a, std::vector<int>& b) {
     const int count = static_cast<int>(faces.size());
     const int first = static_cast<int>(faces.data() - perm_.data());
     const int axis = longest_axis(first, count);
@@ -178,33 +225,33 @@ class Builder {
     using Item = std::pair<double, int>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
     heap.emplace(centroid_[seed][axis], seed);
-    in_a_[seed] = stamp_;
+    in_a_[seed] = stamp;
     while (!heap.empty() && static_cast<int>(a.size()) < count / 2) {
       const int f = heap.top().second;
       heap.pop();
       a.push_back(f);
-      for_each_neighbour(f, [&](int g) {
-        if (in_a_[g] != stamp_) {
-          in_a_[g] = stamp_;
+      for_each_neighbour(f, stamp, [&](int g) {
+        if (in_a_[g] != stamp) {
+          in_a_[g] = stamp;
           heap.emplace(centroid_[g][axis], g);
         }
       });
     }
     // in_a_ also marks the queued front; rebuild it from `a` alone.
-    ++stamp_;
+    const int rest_stamp = new_stamp();
     for (int f : faces)
-      in_set_[f] = stamp_;
+      mark_set(f, rest_stamp);
     for (int f : a)
-      in_a_[f] = stamp_;
+      in_a_[f] = rest_stamp;
     std::vector<int> rest;
     for (int f : faces) {
-      if (in_a_[f] != stamp_) rest.push_back(f);
+      if (in_a_[f] != rest_stamp) rest.push_back(f);
     }
     // Keep the largest component of the rest as the second half; the others touch the first half
     // (the set is connected), so moving them there keeps both halves connected.
     for (int f : a)
-      in_set_[f] = -1;
-    auto comps = components(rest);
+      mark_set(f, -1);
+    auto comps = components(rest, rest_stamp);
     std::size_t best = 0;
     for (std::size_t c = 1; c < comps.size(); ++c) {
       if (comps[c].size() > comps[best].size()) best = c;
@@ -224,8 +271,11 @@ class Builder {
   std::vector<Eigen::Vector3d> centroid_;
   std::vector<int> perm_;
   std::vector<TmpNode> nodes_;
+  // Per-face marks: a split's faces (in_set_), its first half (in_a_), a component search's
+  // visits (seen_). Each mark is a stamp from new_stamp(); concurrent splits own disjoint faces.
   std::vector<int> in_set_, in_a_, seen_;
-  int stamp_ = 0, seen_stamp_ = 0;
+  std::vector<int> neighbour_offsets_, neighbours_;  // CSR, Patch builds only
+  std::atomic<int> next_stamp_{0};
 };
 
 }  // namespace

@@ -2,6 +2,7 @@
 // connectivity flag against a breadth-first search, disks with one consistent boundary loop.
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -379,6 +380,38 @@ TEST(Bvh, BoxesOnlyIsTheSameTreeWithoutFlags) {
         EXPECT_TRUE(boxes.contour(static_cast<int>(i)).empty());
         EXPECT_EQ(boxes.leaf_of_face(boxes.prim_ids()[a.first]) == static_cast<int>(i),
                   a.is_leaf());
+      }
+    }
+  }
+}
+
+// Sibling subtrees are built in parallel (over 2048 faces each): the tree must not depend on the
+// threads. Meshes large enough for several parallel levels, one of them in separate pieces (the
+// patch build's component split), built on one thread and on eight.
+TEST(Bvh, TheSameTreeOnOneThreadAndOnEight) {
+  for (const auto& s : {crumpled_sheet(100, 5), stacked_sheets(70), twisted_strip(800, 12)}) {
+    const Topology topo(s.faces, s.num_vertices);
+    const auto v0 = points(s.v_t0);
+    ASSERT_GT(topo.num_faces(), 8 * 2048);  // three levels of parallel splits
+    for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+      SCOPED_TRACE(::testing::Message() << s.name << " build " << int(build));
+      const auto built = [&](int threads) {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        return Bvh(topo, v0, build);
+      };
+      const Bvh one = built(1), many = built(8);
+      EXPECT_EQ(many.prim_ids(), one.prim_ids());
+      EXPECT_EQ(many.level_offsets(), one.level_offsets());
+      ASSERT_EQ(many.nodes().size(), one.nodes().size());
+      for (std::size_t i = 0; i < one.nodes().size(); ++i) {
+        const BvhNode &a = many.nodes()[i], &b = one.nodes()[i];
+        ASSERT_EQ(a.left, b.left) << "node " << i;
+        ASSERT_EQ(a.first, b.first) << "node " << i;
+        ASSERT_EQ(a.count, b.count) << "node " << i;
+        ASSERT_EQ(a.flags, b.flags) << "node " << i;
+        ASSERT_TRUE(
+            std::ranges::equal(many.contour(static_cast<int>(i)), one.contour(static_cast<int>(i))))
+            << "node " << i;
       }
     }
   }
