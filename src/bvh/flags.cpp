@@ -128,30 +128,50 @@ void Bvh::compute_flags(const Topology& topo) {
   // a union-find over the faces) gives every node's at once. Nodes are numbered after their
   // ancestors, so a backward sweep has merged a node's descendants, and only those among its
   // faces, when it reaches the node.
+  // Each pair of faces of an edge is one join; an edge's joins are independent of the others',
+  // so they are found in parallel, then grouped by node (counting sort). Within a node the order
+  // of the merges does not change how many succeed.
   struct Join {
-    int node, f, g;
+    int f, g;
   };
-  std::vector<Join> joins;
-  joins.reserve(topo.num_edges());
-  for (int e = 0; e < topo.num_edges(); ++e) {
-    const auto ef = topo.edge_faces(e);
-    for (std::size_t x = 0; x < ef.size(); ++x) {
-      for (std::size_t y = x + 1; y < ef.size(); ++y) {
-        const int p = pos[ef[x]], q = pos[ef[y]];
-        int i = 0;
-        for (;;) {
-          const BvhNode& l = nodes_[nodes_[i].left];
-          const bool pl = p < l.first + l.count, ql = q < l.first + l.count;
-          if (pl != ql) break;
-          i = pl ? nodes_[i].left : nodes_[i].left + 1;
+  const int ne = topo.num_edges();
+  std::vector<int> edge_joins(ne + 1, 0);
+  for (int e = 0; e < ne; ++e) {
+    const int k = static_cast<int>(topo.edge_faces(e).size());
+    edge_joins[e + 1] = edge_joins[e] + k * (k - 1) / 2;
+  }
+  std::vector<int> join_node(edge_joins[ne]);
+  std::vector<Join> join_faces(edge_joins[ne]);
+  tbb::parallel_for(tbb::blocked_range<int>(0, ne, 4096), [&](const tbb::blocked_range<int>& r) {
+    for (int e = r.begin(); e != r.end(); ++e) {
+      const auto ef = topo.edge_faces(e);
+      int at = edge_joins[e];
+      for (std::size_t x = 0; x < ef.size(); ++x) {
+        for (std::size_t y = x + 1; y < ef.size(); ++y) {
+          const int p = pos[ef[x]], q = pos[ef[y]];
+          int i = 0;
+          for (;;) {
+            const BvhNode& l = nodes_[nodes_[i].left];
+            const bool pl = p < l.first + l.count, ql = q < l.first + l.count;
+            if (pl != ql) break;
+            i = pl ? nodes_[i].left : nodes_[i].left + 1;
+          }
+          join_node[at] = i;
+          join_faces[at++] = {ef[x], ef[y]};
         }
-        joins.push_back({i, ef[x], ef[y]});
       }
     }
+  });
+  std::vector<int> node_joins(nn + 1, 0);
+  for (int i : join_node)
+    ++node_joins[i + 1];
+  std::partial_sum(node_joins.begin(), node_joins.end(), node_joins.begin());
+  std::vector<Join> joins(join_faces.size());
+  {
+    std::vector<int> cursor(node_joins.begin(), node_joins.end() - 1);
+    for (std::size_t j = 0; j < join_faces.size(); ++j)
+      joins[cursor[join_node[j]]++] = join_faces[j];
   }
-  std::sort(joins.begin(), joins.end(),
-            [](const Join& x, const Join& y) { return x.node > y.node; });
-  std::size_t next_join = 0;
   std::vector<int> parent(topo.num_faces()), comps(nn, 0);
   std::iota(parent.begin(), parent.end(), 0);
   const auto root = [&](int f) {
@@ -169,8 +189,8 @@ void Bvh::compute_flags(const Topology& topo) {
       continue;
     }
     comps[i] = comps[n.left] + comps[n.left + 1];
-    for (; next_join < joins.size() && joins[next_join].node == i; ++next_join) {
-      const int a = root(joins[next_join].f), b = root(joins[next_join].g);
+    for (int j = node_joins[i]; j < node_joins[i + 1]; ++j) {
+      const int a = root(joins[j].f), b = root(joins[j].g);
       if (a == b) continue;
       parent[a] = b;
       --comps[i];
