@@ -95,7 +95,8 @@ class Bvh {
   Bvh() = default;
   /// Builds over all faces of `topology` using the reference positions (n x 3) for the splits.
   /// The tree keeps a copy of the faces it needs: it stays valid, and can be copied and moved,
-  /// independently of `topology`.
+  /// independently of `topology`. Large subtrees are built in parallel (oneTBB); the tree is the
+  /// same for any number of threads.
   Bvh(const Topology& topology, std::span<const Eigen::Vector3d> reference, BvhBuild build);
   /// The same tree without the per-node topology flags and contours, which take about half of a
   /// build's time: for box-only traversals that rebuild their tree as the mesh deforms. Every
