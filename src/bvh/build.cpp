@@ -30,7 +30,7 @@ struct TmpNode {
 class Builder {
  public:
   Builder(const Topology& topo, std::span<const Eigen::Vector3d> ref, BvhBuild build)
-      : topo_(topo), build_(build) {
+      : build_(build) {
     const int nf = topo.num_faces();
     centroid_.resize(nf);
     for (int f = 0; f < nf; ++f) {
@@ -266,7 +266,6 @@ class Builder {
     std::sort(b.begin(), b.end());
   }
 
-  const Topology& topo_;
   BvhBuild build_;
   std::vector<Eigen::Vector3d> centroid_;
   std::vector<int> perm_;
