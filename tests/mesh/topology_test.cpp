@@ -240,6 +240,35 @@ TEST(Topology, RejectsNegativeVertexCount) {
   EXPECT_THROW(Topology({}, -1), InputError);
 }
 
+// validate_faces (what mesh readers and sewing check, without building a Topology) throws
+// exactly the constructor's error for each bad input, and nothing for good ones.
+TEST(Topology, ValidateFacesGivesTheConstructorsErrors) {
+  const auto validate_error = [](const std::vector<Face>& faces, int nv) -> std::string {
+    try {
+      validate_faces(faces, nv);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::vector<std::pair<std::vector<Face>, int>> inputs = {
+      {{{0, 1, 2}, {1, 2, 3}}, 3},              // index out of range
+      {{{0, 1, 2}, {0, 1, 2}, {0, -1, 2}}, 3},  // negative index, after a duplicate
+      {{{0, 1, 2}, {2, 1, 2}}, 3},              // repeated vertex
+      {{}, -1},                                 // negative vertex count
+      {{{0, 1, 2}, {2, 1, 0}, {0, 3, 1}}, 5},   // valid: duplicate, isolated vertex
+      {{}, 0},                                  // valid: empty
+  };
+  int bad = 0;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const auto& [faces, nv] = inputs[i];
+    const std::string want = error_of(faces, nv);
+    EXPECT_EQ(validate_error(faces, nv), want) << "input " << i;
+    bad += want.empty() ? 0 : 1;
+  }
+  EXPECT_EQ(bad, 4);
+}
+
 // Random grids with random diagonals, holes, duplicates, non-manifold fins, isolated vertices,
 // shuffled faces and permuted vertex ids.
 TEST(Topology, HubVerticesMatchBruteForce) {
