@@ -584,7 +584,7 @@ class Ownership {
  public:
   Ownership() = default;
   /// Keeps a pointer to `topo`, which must outlive it.
-  explicit Ownership(const Topology& topo) : topo_(&topo), faces_(topo.faces().data()) {
+  explicit Ownership(const Topology& topo) : topo_(&topo) {
     // Every edge's and every face's record depends on the topology alone: filled in parallel.
     const auto for_each = [](int n, auto&& fn) {
       tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
@@ -654,10 +654,11 @@ class Ownership {
   /// Whether f (a face of v, sharing no vertex with g) is the R-triangle of (v, g): every face of
   /// v before it touches g.
   [[nodiscard]] bool owns_vf(int v, int g, int f) const {
-    const Face& tg = faces_[g];
+    const auto& faces = topo_->faces();
+    const Face& tg = faces[g];
     for (int h : topo_->vertex_faces(v)) {
       if (h == f) return true;
-      if (!share_vertex(faces_[h], tg)) return false;
+      if (!share_vertex(faces[h], tg)) return false;
     }
     return false;
   }
@@ -688,17 +689,17 @@ class Ownership {
   };
 
   [[nodiscard]] bool owns_ee_general(int e1, int e2, int x, int y) const {
+    const auto& faces = topo_->faces();
     for (int fa : topo_->edge_faces(e1)) {
       for (int fb : topo_->edge_faces(e2)) {
         if (fa == x && fb == y) return true;
-        if (!share_vertex(faces_[fa], faces_[fb])) return false;
+        if (!share_vertex(faces[fa], faces[fb])) return false;
       }
     }
     return false;
   }
 
   const Topology* topo_ = nullptr;
-  const Face* faces_ = nullptr;
   std::vector<EdgeFaces> pair_;
   std::vector<FaceRecord> records_;
 };

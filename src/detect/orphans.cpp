@@ -73,9 +73,9 @@ void ee_orphans_of(const Topology& topo, int ea, Scratch& s) {
     for (int g : topo.vertex_faces(x)) {
       const Face& tg = faces[g];
       const int i0 = corner_index(tg, a0), i1 = corner_index(tg, a1);
+      if (i0 >= 0 && i1 >= 0) continue;  // a face of ea: every edge touches it
       // Bit k: edge k of g (corners k and k + 1) may be eb.
       unsigned edges = 0;
-      if (i0 >= 0 && i1 >= 0) continue;
       if (i0 >= 0 || i1 >= 0) {
         edges = 1u << ((std::max(i0, i1) + 1) % 3);
       } else if (has_apexes(tg)) {
