@@ -11,6 +11,7 @@
 #include <cfloat>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -30,6 +31,87 @@ using lanes::Vec3;
 template <class B>
 B max_abs(const Vec3<B>& p) {
   return xsimd::max(xsimd::max(xsimd::abs(p.x), xsimd::abs(p.y)), xsimd::abs(p.z));
+}
+
+// motion.cpp's inverse_binade, without the call where the answer is in m's exponent bits alone:
+// m normal and below 2^1021 (biased exponent 1..2044), so that 2^-e is a normal double too.
+inline double scale_of(double m) {
+  const std::uint64_t e = std::bit_cast<std::uint64_t>(m) >> 52;
+  if (e >= 1 && e <= 2044) return std::bit_cast<double>((2045 - e) << 52);
+  return inverse_binade(m);
+}
+
+// Bit l of the result: lane l of m. One movemask on SSE2 and AVX2 (xsimd has no such accessor);
+// lane by lane elsewhere.
+template <class Arch>
+[[gnu::always_inline]] inline unsigned lane_bits(const xsimd::batch_bool<double, Arch>& m) {
+#if defined(__AVX2__)
+  if constexpr (std::is_same_v<Arch, xsimd::avx2>) {
+    return static_cast<unsigned>(_mm256_movemask_pd(m));
+  }
+#endif
+  if constexpr (std::is_same_v<Arch, xsimd::sse2>) {
+    return static_cast<unsigned>(_mm_movemask_pd(m));
+  } else {
+    constexpr int W = static_cast<int>(xsimd::batch_bool<double, Arch>::size);
+    bool b[W];
+    m.store_unaligned(b);
+    unsigned bits = 0;
+    for (int l = 0; l < W; ++l)
+      bits |= unsigned(b[l]) << l;
+    return bits;
+  }
+}
+
+// Four consecutive doubles of each lane's own record as four batches, and back: the 4 x 4
+// transpose the settle's per-query rows need (W records of 32 doubles in, 32 batches of W lanes
+// out). AVX2 shuffles where a batch is four doubles; element by element otherwise. Moves only.
+template <class B>
+[[gnu::always_inline]] inline void rows_from_records(const double* const* rec, int first, B* out) {
+  constexpr int W = static_cast<int>(B::size);
+#if defined(__AVX2__)
+  if constexpr (W == 4 && std::is_same_v<typename B::arch_type, xsimd::avx2>) {
+    const __m256d r0 = _mm256_loadu_pd(rec[0] + first), r1 = _mm256_loadu_pd(rec[1] + first);
+    const __m256d r2 = _mm256_loadu_pd(rec[2] + first), r3 = _mm256_loadu_pd(rec[3] + first);
+    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    out[0] = _mm256_permute2f128_pd(t0, t2, 0x20);
+    out[1] = _mm256_permute2f128_pd(t1, t3, 0x20);
+    out[2] = _mm256_permute2f128_pd(t0, t2, 0x31);
+    out[3] = _mm256_permute2f128_pd(t1, t3, 0x31);
+    return;
+  }
+#endif
+  alignas(64) double t[4][W];
+  for (int k = 0; k < 4; ++k) {
+    for (int l = 0; l < W; ++l)
+      t[k][l] = rec[l][first + k];
+  }
+  for (int k = 0; k < 4; ++k)
+    out[k] = B::load_aligned(t[k]);
+}
+template <class B>
+[[gnu::always_inline]] inline void rows_to_records(const B* in, double* const* rec, int first) {
+  constexpr int W = static_cast<int>(B::size);
+#if defined(__AVX2__)
+  if constexpr (W == 4 && std::is_same_v<typename B::arch_type, xsimd::avx2>) {
+    const __m256d r0 = in[0], r1 = in[1], r2 = in[2], r3 = in[3];
+    const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+    const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+    _mm256_storeu_pd(rec[0] + first, _mm256_permute2f128_pd(t0, t2, 0x20));
+    _mm256_storeu_pd(rec[1] + first, _mm256_permute2f128_pd(t1, t3, 0x20));
+    _mm256_storeu_pd(rec[2] + first, _mm256_permute2f128_pd(t0, t2, 0x31));
+    _mm256_storeu_pd(rec[3] + first, _mm256_permute2f128_pd(t1, t3, 0x31));
+    return;
+  }
+#endif
+  alignas(64) double t[4][W];
+  for (int k = 0; k < 4; ++k)
+    in[k].store_aligned(t[k]);
+  for (int k = 0; k < 4; ++k) {
+    for (int l = 0; l < W; ++l)
+      rec[l][first + k] = t[k][l];
+  }
 }
 
 // cubic.cpp cubic_of, lane by lane: the coplanarity cubic's Bernstein coefficients k and the
@@ -90,12 +172,12 @@ void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
     const B e = eta_scale * (a * a * a) + eta_floor;
     const Mask decided = finite && (a >= low) && (a <= high);
     const Mask culled = one_sign(cubic.k, e);
-    bool d[W], c[W];
-    decided.store_unaligned(d);
-    culled.store_unaligned(c);
+    const unsigned d = lane_bits(decided), c = lane_bits(culled);
     const int n = b.size - i < W ? b.size - i : W;
     for (int l = 0; l < n; ++l) {
-      verdict[i + l] = !d[l] ? NpVerdict::Undecided : (c[l] ? NpVerdict::Culled : NpVerdict::Kept);
+      verdict[i + l] = ((d >> l) & 1u) == 0   ? NpVerdict::Undecided
+                       : ((c >> l) & 1u) != 0 ? NpVerdict::Culled
+                                              : NpVerdict::Kept;
     }
   }
 }
@@ -109,8 +191,11 @@ struct SettleScratch {
     int q, j;     // kept query, range [j, j + 1] / 2^level
     double b[4];  // the cubic's Bernstein coefficients on it
   };
-  double d[30][kCap];  // inside_data's difference vectors at t = 0 and 1 (scaled), per query
-  double e[kCap], ein[kCap];
+  // One record per query, so that a range's lanes load theirs whole (rows_from_records):
+  // inside_data's five difference vectors (scaled), each at t = 0 then t = 1 (x, y, z), in rows
+  // 0..29; the subdivision error e in row kE, the inside test's error in row kEin.
+  static constexpr int kRow = 32, kE = 30, kEin = 31;
+  alignas(64) double rec[kCap][kRow];
   bool active[kCap];  // the scaled cubic is not NP-culled
   // The ranges examined per level (bit j: range j); the earliest certified and open ranges.
   std::uint64_t examined[kCap][kLevels];
@@ -135,6 +220,7 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   static_assert(kFirstInsideLevel == 2 && kSettleLevel < 64);
   using V = Vec3<B>;
   using Range = SettleScratch::Range;
+  constexpr int kRow = SettleScratch::kRow;
   constexpr int kLevels = SettleScratch::kLevels;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   struct I {  // certify.cpp's midpoint-radius interval
@@ -192,7 +278,7 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
     alignas(64) double lane_top[W], lane_scale[W];
     top.store_aligned(lane_top);
     for (int l = 0; l < W; ++l)
-      lane_scale[l] = inverse_binade(lane_top[l]);
+      lane_scale[l] = scale_of(lane_top[l]);
     const B scale = B::load_aligned(lane_scale);
     V x0[4], x1[4];
     for (int p = 0; p < 4; ++p) {
@@ -212,22 +298,26 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
         xsimd::max(xsimd::max(xsimd::max(xsimd::abs(k[0]), xsimd::abs(k[1])), xsimd::abs(k[2])),
                    xsimd::abs(k[3]));
     const B e = eta + sub_scale * kmax;
+    B row[kRow];
     B amax(0.0);
     for (int t = 0; t < 5; ++t) {
       const V d0 = sub(x0[idx[t][0]], x0[idx[t][1]]);
       const V d1 = sub(x1[idx[t][0]], x1[idx[t][1]]);
       amax = xsimd::max(amax, xsimd::max(max_abs(d0), max_abs(d1)));
-      d0.x.store_unaligned(&sc.d[6 * t][s]);
-      d0.y.store_unaligned(&sc.d[6 * t + 1][s]);
-      d0.z.store_unaligned(&sc.d[6 * t + 2][s]);
-      d1.x.store_unaligned(&sc.d[6 * t + 3][s]);
-      d1.y.store_unaligned(&sc.d[6 * t + 4][s]);
-      d1.z.store_unaligned(&sc.d[6 * t + 5][s]);
+      B* r = row + 6 * t;
+      r[0] = d0.x, r[1] = d0.y, r[2] = d0.z, r[3] = d1.x, r[4] = d1.y, r[5] = d1.z;
     }
     const B mm = amax * widen;
-    const B ein = in_scale * (mm * mm) * (mm * mm) + in_floor;
-    e.store_unaligned(&sc.e[s]);
-    ein.store_unaligned(&sc.ein[s]);
+    row[SettleScratch::kE] = e;
+    row[SettleScratch::kEin] = in_scale * (mm * mm) * (mm * mm) + in_floor;
+    {
+      // Lanes past n write the records of queries past nk, which nothing reads.
+      double* dst[W];
+      for (int l = 0; l < W; ++l)
+        dst[l] = sc.rec[s + l];
+      for (int k = 0; k < kRow; k += 4)
+        rows_to_records(row + k, dst, k);
+    }
     // The search's first levels (no inside test before kFirstInsideLevel): the whole step, its
     // halves, its quarters, each examined where the cubic is not of one sign on it and its
     // parent was.
@@ -241,28 +331,26 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
       open2[2 * h] = open1[h] && !one_sign(quarter_b[2 * h], e);
       open2[2 * h + 1] = open1[h] && !one_sign(quarter_b[2 * h + 1], e);
     }
-    bool act[W], o0[W], o1[2][W], o2[4][W];
+    const unsigned act = lane_bits(active), o0 = lane_bits(open0);
+    const unsigned o1[2] = {lane_bits(open1[0]), lane_bits(open1[1])};
+    unsigned o2[4];
     alignas(64) double qb[4][4][W];
-    active.store_unaligned(act);
-    open0.store_unaligned(o0);
-    for (int h = 0; h < 2; ++h)
-      open1[h].store_unaligned(o1[h]);
     for (int j = 0; j < 4; ++j) {
-      open2[j].store_unaligned(o2[j]);
+      o2[j] = lane_bits(open2[j]);
       for (int c = 0; c < 4; ++c)
         quarter_b[j][c].store_aligned(qb[j][c]);
     }
     for (int l = 0; l < n; ++l) {
       const int q = s + l;
-      sc.active[q] = act[l];
+      sc.active[q] = ((act >> l) & 1u) != 0;
       sc.hit_lo[q] = sc.open_lo[q] = kInf;
       std::uint64_t* ex = sc.examined[q];
       for (int v = 0; v < kLevels; ++v)
         ex[v] = 0;
-      ex[0] = o0[l] ? 1 : 0;
-      ex[1] = (o1[0][l] ? 1 : 0) | (o1[1][l] ? 2 : 0);
+      ex[0] = (o0 >> l) & 1u;
+      ex[1] = ((o1[0] >> l) & 1u) | ((o1[1] >> l) & 1u) << 1;
       for (int j = 0; j < 4; ++j) {
-        if (o2[j][l])
+        if (((o2[j] >> l) & 1u) != 0)
           sc.ranges.push_back(Range{q, j, {qb[j][0][l], qb[j][1][l], qb[j][2][l], qb[j][3][l]}});
       }
     }
@@ -296,38 +384,32 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
       if (m == 0) break;
       for (int l = m; l < W; ++l)
         g[l] = g[m - 1];
-      // Row by row, so that each row's W values become one vector without a memory round trip.
-      int gq[W];
-      for (int l = 0; l < W; ++l)
-        gq[l] = g[l]->q;
-      alignas(64) double col[38][W];
-      for (int row = 0; row < 30; ++row) {
+      // The lanes' query records and Bernstein coefficients, transposed into rows.
+      B row[kRow], cb[4];
+      {
+        const double* src[W];
         for (int l = 0; l < W; ++l)
-          col[row][l] = sc.d[row][gq[l]];
-      }
-      for (int l = 0; l < W; ++l) {
-        col[30][l] = sc.e[gq[l]];
-        col[31][l] = sc.ein[gq[l]];
-      }
-      for (int c = 0; c < 4; ++c) {
+          src[l] = sc.rec[g[l]->q];
+        for (int k = 0; k < kRow; k += 4)
+          rows_from_records(src, k, row + k);
         for (int l = 0; l < W; ++l)
-          col[32 + c][l] = g[l]->b[c];
-      }
-      for (int l = 0; l < W; ++l) {
-        col[36][l] = width * g[l]->j;
-        col[37][l] = width * (g[l]->j + 1);
+          src[l] = g[l]->b;
+        rows_from_records(src, 0, cb);
       }
       V d0[5], d1[5];
       for (int t = 0; t < 5; ++t) {
-        d0[t] = V{B::load_aligned(col[6 * t]), B::load_aligned(col[6 * t + 1]),
-                  B::load_aligned(col[6 * t + 2])};
-        d1[t] = V{B::load_aligned(col[6 * t + 3]), B::load_aligned(col[6 * t + 4]),
-                  B::load_aligned(col[6 * t + 5])};
+        const B* r = row + 6 * t;
+        d0[t] = V{r[0], r[1], r[2]};
+        d1[t] = V{r[3], r[4], r[5]};
       }
-      const B e = B::load_aligned(col[30]), ein = B::load_aligned(col[31]);
-      const B cb[4] = {B::load_aligned(col[32]), B::load_aligned(col[33]), B::load_aligned(col[34]),
-                       B::load_aligned(col[35])};
-      const B lo = B::load_aligned(col[36]), hi = B::load_aligned(col[37]);
+      const B e = row[SettleScratch::kE], ein = row[SettleScratch::kEin];
+      // The range [j, j + 1] 2^-level as width * j and width * (j + 1): j and j + 1 are exact.
+      alignas(64) double lane_j[W], lane_lo[W];
+      for (int l = 0; l < W; ++l)
+        lane_j[l] = g[l]->j;
+      const B jb = B::load_aligned(lane_j);
+      const B lo = B(width) * jb, hi = B(width) * (jb + B(1.0));
+      lo.store_aligned(lane_lo);
       // inside_over over [lo, hi]: No (a function below -ein), Yes (all above ein). As soon as
       // every lane is No the other functions cannot change that, and Yes matters only where the
       // answer is not No: stop there.
@@ -368,15 +450,14 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
       const Mask change = ((cb[0] > e) && (cb[3] < -e)) || ((cb[0] < -e) && (cb[3] > e));
       const Mask hit = left && in.yes && change;
       const Mask split = left && !hit;
-      bool lf[W], ht[W], sl[W] = {}, sr[W] = {};
-      left.store_unaligned(lf);
-      hit.store_unaligned(ht);
+      const unsigned lf = lane_bits(left), ht = lane_bits(hit);
+      unsigned sl = 0, sr = 0;
       alignas(64) double kb[2][4][W];
       if (level < kSettleLevel && xsimd::any(split)) {
         B lb[4], rb[4];
         halve(cb, lb, rb);
-        (split && !one_sign(lb, e)).store_unaligned(sl);
-        (split && !one_sign(rb, e)).store_unaligned(sr);
+        sl = lane_bits(split && !one_sign(lb, e));
+        sr = lane_bits(split && !one_sign(rb, e));
         for (int c = 0; c < 4; ++c) {
           lb[c].store_aligned(kb[0][c]);
           rb[c].store_aligned(kb[1][c]);
@@ -386,9 +467,9 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
         const Range& rg = *g[l];
         const int q = rg.q;
         sc.examined[q][level] |= std::uint64_t(1) << rg.j;
-        if (!lf[l]) continue;
-        const double lo_t = col[36][l];
-        if (ht[l]) {
+        if (((lf >> l) & 1u) == 0) continue;
+        const double lo_t = lane_lo[l];
+        if (((ht >> l) & 1u) != 0) {
           if (lo_t < sc.hit_lo[q]) {
             sc.hit_lo[q] = lo_t;
             sc.hit_level[q] = level;
@@ -402,11 +483,11 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
           sc.open_lo[q] = std::min(sc.open_lo[q], lo_t);
           continue;
         }
-        if (sl[l]) {
+        if (((sl >> l) & 1u) != 0) {
           sc.next.push_back(
               Range{q, 2 * rg.j, {kb[0][0][l], kb[0][1][l], kb[0][2][l], kb[0][3][l]}});
         }
-        if (sr[l]) {
+        if (((sr >> l) & 1u) != 0) {
           sc.next.push_back(
               Range{q, 2 * rg.j + 1, {kb[1][0][l], kb[1][1][l], kb[1][2][l], kb[1][3][l]}});
         }
@@ -439,8 +520,8 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
     }
     if (before > kFastPathBudget) continue;
     const double width = 1.0 / (1 << hv);
-    toi[kept[q]] = first_root_bound(sc.hit_b[q], width * hj, width * (hj + 1), hv, sc.e[q],
-                                    hv > target ? hv : target);
+    toi[kept[q]] = first_root_bound(sc.hit_b[q], width * hj, width * (hj + 1), hv,
+                                    sc.rec[q][SettleScratch::kE], hv > target ? hv : target);
     settled[kept[q]] = FastSettled::Hit;
   }
 }
