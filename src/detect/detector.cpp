@@ -226,14 +226,16 @@ struct SelfDetector::Impl {
   // vertex (left to the orphans, only counted). Plain pointers: the output's stores could
   // otherwise alias the containers.
   [[nodiscard]] auto leaf_step() const {
-    return [np = bvh.nodes().data(), pp = bvh.prim_ids().data(), fp = topo.faces().data()](
+    // The corners in tree order (prim_faces): neighbouring leaves' faces sit together there,
+    // wherever their ids are.
+    return [np = bvh.nodes().data(), pp = bvh.prim_ids().data(), pf = bvh.prim_faces().data()](
                int a, int b, PairBuffer& out) {
-      const int fa = pp[np[a].first], fb = pp[np[b].first];
-      if (faces_touch(fp[fa], fp[fb])) {
+      const int ia = np[a].first, ib = np[b].first;
+      if (faces_touch(pf[ia], pf[ib])) {
         ++out.adjacent;
         return;
       }
-      out.pairs.push(fa, fb);
+      out.pairs.push(pp[ia], pp[ib]);
     };
   }
 
@@ -650,15 +652,15 @@ struct SelfDetector::Impl {
       std::vector<GroupPairs> groups;
     };
     auto no_cull = [](int, detail::TraversalCounters&) { return false; };
-    auto leaf = [np = nodes.data(), pp = bvh.prim_ids().data(), fp = topo.faces().data()](
+    auto leaf = [np = nodes.data(), pp = bvh.prim_ids().data(), pf = bvh.prim_faces().data()](
                     int a, int b, Local& out) {
       GroupPairs& gp = out.groups[out.g];
-      const int fa = pp[np[a].first], fb = pp[np[b].first];
-      if (faces_touch(fp[fa], fp[fb])) {
+      const int ia = np[a].first, ib = np[b].first;
+      if (faces_touch(pf[ia], pf[ib])) {
         ++gp.adjacent;
         return;
       }
-      gp.pairs.push(fa, fb);
+      gp.pairs.push(pp[ia], pp[ib]);
     };
     auto tr = detail::make_traversal(nodes, nodes, {}, {}, no_cull, leaf);
     tbb::enumerable_thread_specific<Local> locals([ng] {

@@ -55,6 +55,9 @@ TEST(Bvh, StructureAndFlagsMatchBruteForce) {
       std::vector<int> all(topo.num_faces());
       std::iota(all.begin(), all.end(), 0);
       EXPECT_EQ(sorted, all);
+      ASSERT_EQ(bvh.prim_faces().size(), all.size());
+      for (std::size_t p = 0; p < all.size(); ++p)
+        EXPECT_EQ(bvh.prim_faces()[p], topo.faces()[bvh.prim_ids()[p]]) << "position " << p;
       for (int i = 0; i < static_cast<int>(nodes.size()); ++i) {
         const BvhNode& n = nodes[i];
         std::vector<int> faces(bvh.prim_ids().begin() + n.first,

@@ -106,6 +106,9 @@ class Bvh {
 
   [[nodiscard]] const std::vector<BvhNode>& nodes() const { return nodes_; }
   [[nodiscard]] const std::vector<int>& prim_ids() const { return prim_ids_; }
+  /// The corners of face prim_ids()[i] at each position i: a leaf's corners in tree order, read
+  /// without the indirection into faces() (whose ids may lie anywhere in memory).
+  [[nodiscard]] const std::vector<Face>& prim_faces() const { return prim_faces_; }
   /// Node index of the leaf that holds face f.
   [[nodiscard]] int leaf_of_face(int f) const { return leaf_of_face_[f]; }
   /// Index of a node's parent; -1 for the root.
