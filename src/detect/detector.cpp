@@ -357,7 +357,7 @@ struct SelfDetector::Impl {
       for (int line = 0; line < 3; ++line)
         detail::prefetch(block + 64 * line);
     };
-    // Without the distance filter, pair i of the list, faces f and g.
+    // Without the whole-triangle bound (faces_apart_filter), pair i of the list, faces f and g.
     const auto one = [&](std::size_t i, int f, int g, NarrowBuffer& out) {
       if (near != nullptr) {
         (*near)[i] =
@@ -369,7 +369,7 @@ struct SelfDetector::Impl {
       ++out.c.triangle_pairs;
       triangle_pair(ctx, f, g, out, kvf, kee);
     };
-    // With the distance filter, pairs [k0, k1) of a piece: the box test and the queueing of the
+    // With it, pairs [k0, k1) of a piece: the box test and the queueing of the
     // pairs past it, the whole-triangle filter on them at once, then their feature pairs, in
     // list order.
     const auto batch = [&](std::size_t first, std::span<const detail::FacePair> piece,
@@ -409,7 +409,7 @@ struct SelfDetector::Impl {
         triangle_pair(ctx, piece[k].first, piece[k].second, out, kvf, kee);
       }
     };
-    const bool batched = ctx.distance_filter();
+    const bool batched = ctx.faces_apart_filter();
     constexpr std::size_t kBatch = detail::FacesApartBatch::kCapacity;
     const std::vector<detail::PairList::Piece> pieces = pairs.pieces(kPiece);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces.size(), 1),

@@ -162,7 +162,8 @@ struct FeatureContext {
   std::span<const Eigen::Vector3d> v0, v1;
   double margin = 0;  // thickness / 2
   bool np_filter = true;
-  int distance_depth = 0;  // DetectOptions::distance_filter_depth
+  bool triangle_filter = false;  // DetectOptions::triangle_filter
+  int distance_depth = 0;        // DetectOptions::distance_filter_depth
   CcdOptions ccd;
   /// Optional swept boxes of every vertex, edge and face for this step (`precompute_boxes`);
   /// empty: computed on demand.
@@ -289,6 +290,11 @@ struct FeatureContext {
 
   /// Whether the distance filter is the one in use (thickness > 0, filters on).
   [[nodiscard]] bool distance_filter() const { return np_filter && ccd.thickness > 0; }
+  /// Whether triangle pairs go through the whole-triangle distance bound first: with the distance
+  /// filter, or at zero thickness with DetectOptions::triangle_filter.
+  [[nodiscard]] bool faces_apart_filter() const {
+    return np_filter && (ccd.thickness > 0 || triangle_filter);
+  }
 
   /// Whether a query's first test is the cubic NP filter (unscaled_np_filter), whose culls the
   /// batched filter may decide: at zero thickness, as the separate filter or as the fast path's
@@ -430,6 +436,7 @@ inline FeatureContext ccd_context(const Topology& topo, std::span<const Eigen::V
   ctx.v1 = v1;
   ctx.margin = 0.5 * options.thickness;
   ctx.np_filter = options.np_filter;
+  ctx.triangle_filter = options.triangle_filter;
   ctx.ccd = CcdOptions{options.thickness, options.fast_path};
   ctx.ccd.toi_tolerance = options.toi_tolerance;
   ctx.distance_depth = options.distance_filter_depth;

@@ -284,7 +284,7 @@ struct PairDetector::Impl {
     b.boxes.update(cb, b.step);
     tbb::enumerable_thread_specific<Buffer> locals;
     const Scope scope{*this};
-    const bool batched = ca.distance_filter();
+    const bool batched = ca.faces_apart_filter();
     constexpr std::size_t kBatch = detail::FacesApartBatch::kCapacity;
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, pairs.size(), kBatch),

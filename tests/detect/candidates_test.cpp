@@ -60,7 +60,8 @@ TEST(Candidates, KernelsOnTheCandidatesFindWhatTheDetectorFinds) {
       SCOPED_TRACE(::testing::Message() << s.name << " linked " << linked);
       DetectOptions o;
       o.culling = Culling::None;
-      if (linked) {  // link some vertices far apart in the mesh, as seams do
+      o.triangle_filter = false;  // every overlapping feature pair reaches the feature tests
+      if (linked) {               // link some vertices far apart in the mesh, as seams do
         for (int v = 0; v + 7 < s.num_vertices; v += 13)
           o.linked_vertices.emplace_back(v, s.num_vertices - 1 - v);
       }
@@ -96,6 +97,16 @@ TEST(Candidates, KernelsOnTheCandidatesFindWhatTheDetectorFinds) {
       const DetectResult got = run_kernels(topo, s.v_t0, s.v_t1, all, o);
       EXPECT_EQ(got.vf, expected.vf);
       EXPECT_EQ(got.ee, expected.ee);
+      // The whole-triangle bound first drops triangle pairs that never touch: the same
+      // collisions from fewer feature tests.
+      DetectOptions with = o;
+      with.triangle_filter = true;
+      SelfDetector filtered(s.faces, s.num_vertices, s.v_t0, with);
+      const DetectResult f = filtered.detect(s.v_t0, s.v_t1);
+      EXPECT_EQ(f.vf, expected.vf);
+      EXPECT_EQ(f.ee, expected.ee);
+      EXPECT_GT(f.stats.triangle_pairs_apart, 0u);
+      EXPECT_LT(f.stats.vf_tests + f.stats.ee_tests, vf_tests + ee_tests);
 
       // Each feature pair once: per triangle pair, unsorted, no repeats, none an orphan.
       FeaturePairs owned;

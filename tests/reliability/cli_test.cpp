@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
@@ -213,25 +214,39 @@ TEST(CliDetect, JsonHoldsTheDetectorsCollisionsExactly) {
 }
 
 TEST(CliDetect, ThicknessReportsTrianglePairsCulledWhole) {
-  // With a thickness the distance filter culls whole triangle pairs first: the count is in the
-  // JSON and the summary, and is 0 without a thickness (the cubic filter then works alone).
+  // The whole-triangle distance bound culls whole triangle pairs first: the count is in the JSON
+  // and the summary. With a thickness it is part of the distance filter; at zero thickness it
+  // runs unless --no-triangle-filter asks for the cubic filter alone (then the count is 0), and
+  // the collisions are the same either way.
   CliScratch dir;
   write_step(dir);
-  for (const char* thickness : {"0", "0.001"}) {
-    const auto r = dir.run(std::string("detect --t0 t0.obj --t1 t1.obj --thickness ") + thickness +
-                           " --json out.json");
+  std::map<std::string, nlohmann::json> out;
+  for (const char* args :
+       {"--thickness 0", "--thickness 0 --no-triangle-filter", "--thickness 0.001"}) {
+    SCOPED_TRACE(args);
+    const auto r =
+        dir.run(std::string("detect --t0 t0.obj --t1 t1.obj ") + args + " --json out.json");
     ASSERT_EQ(r.code, 0) << r.err;
     const auto j = nlohmann::json::parse(CliScratch::slurp(dir / "out.json"));
     const auto apart = j["stats"]["triangle_pairs_apart"].get<std::uint64_t>();
     const auto pairs = j["stats"]["triangle_pairs"].get<std::uint64_t>();
-    EXPECT_NE(r.out.find("culled whole by the distance filter"), std::string::npos) << r.out;
-    if (std::string(thickness) == "0") {
+    EXPECT_NE(r.out.find("culled whole by the triangle distance bound"), std::string::npos)
+        << r.out;
+    if (std::string(args).find("--no-triangle-filter") != std::string::npos) {
       EXPECT_EQ(apart, 0u);
     } else {
       EXPECT_GT(apart, 0u);
       EXPECT_LT(apart, pairs);
     }
+    out[args] = j;
   }
+  const auto& with = out["--thickness 0"];
+  const auto& without = out["--thickness 0 --no-triangle-filter"];
+  EXPECT_EQ(with["vf"], without["vf"]);
+  EXPECT_EQ(with["ee"], without["ee"]);
+  EXPECT_EQ(with["stats"]["triangle_pairs"], without["stats"]["triangle_pairs"]);
+  EXPECT_LT(with["stats"]["ee_tests"].get<std::uint64_t>(),
+            without["stats"]["ee_tests"].get<std::uint64_t>());
 }
 
 TEST(CliDetect, PrintsItsPhasesAndSetupTimes) {
