@@ -51,7 +51,7 @@ using Tri = P3<T>[3];
 // How far b lies wholly on one side of a's plane (0 where it straddles it). The normal is trusted
 // as in the feature bounds (proximity.cpp): only where the sine of a's angle at a[0] exceeds 1e-3.
 template <class T>
-T plane_separation(const Tri<T>& a, const Tri<T>& b) {
+[[gnu::always_inline]] inline T plane_separation(const Tri<T>& a, const Tri<T>& b) {
   using std::sqrt;
   const P3<T> u = sub(a[1], a[0]), v = sub(a[2], a[0]);
   const P3<T> w = cross(u, v);
@@ -70,7 +70,7 @@ T plane_separation(const Tri<T>& a, const Tri<T>& b) {
 
 // Euclidean gap between the two triangles' boxes (0 where they overlap).
 template <class T>
-T box_gap(const Tri<T>& a, const Tri<T>& b) {
+[[gnu::always_inline]] inline T box_gap(const Tri<T>& a, const Tri<T>& b) {
   using std::sqrt;
   P3<T> lo_a = a[0], hi_a = a[0], lo_b = b[0], hi_b = b[0];
   for (int k = 1; k < 3; ++k) {
@@ -86,7 +86,7 @@ T box_gap(const Tri<T>& a, const Tri<T>& b) {
 
 // slack.hpp's coordinate_slack of the six corners.
 template <class T>
-T slack(const Tri<T>& a, const Tri<T>& b) {
+[[gnu::always_inline]] inline T slack(const Tri<T>& a, const Tri<T>& b) {
   using std::abs;
   T m(1.0);
   for (const Tri<T>* t : {&a, &b}) {
@@ -100,7 +100,7 @@ T slack(const Tri<T>& a, const Tri<T>& b) {
 
 // triangle_triangle_bound given the two triangles' slack.
 template <class T>
-T bound_less(const Tri<T>& a, const Tri<T>& b, const T& slack) {
+[[gnu::always_inline]] inline T bound_less(const Tri<T>& a, const Tri<T>& b, const T& slack) {
   const T bound = max_of(max_of(box_gap(a, b), plane_separation(a, b)), plane_separation(b, a));
   return max_of(T(0.0), bound - slack);
 }
@@ -112,8 +112,9 @@ T triangle_triangle_bound(const Tri<T>& a, const Tri<T>& b) {
 
 // triangles_filter_culls: the verdict, and the bound at t1 in `bound_t1`.
 template <class T>
-auto triangles_filter(const Tri<T>& a_t0, const Tri<T>& a_t1, const Tri<T>& b_t0,
-                      const Tri<T>& b_t1, const T& thickness, T& bound_t1) {
+[[gnu::always_inline]] inline auto triangles_filter(const Tri<T>& a_t0, const Tri<T>& a_t1,
+                                                    const Tri<T>& b_t0, const Tri<T>& b_t1,
+                                                    const T& thickness, T& bound_t1) {
   using std::isfinite;
   using std::sqrt;
   T move2(0.0);
