@@ -146,24 +146,37 @@ class Builder {
     }
   }
 
+  // Edge-connected components of a face set, one after another in `faces` (each in the order its
+  // breadth-first search reached it): component c is faces[start[c], start[c + 1]). Two
+  // allocations whatever the number of components.
+  struct Components {
+    std::vector<int> faces, start;
+    [[nodiscard]] std::size_t size() const { return start.size() - 1; }
+    [[nodiscard]] std::span<const int> operator[](std::size_t c) const {
+      return {faces.data() + start[c], static_cast<std::size_t>(start[c + 1] - start[c])};
+    }
+  };
+
   // Edge-connected components of `faces`, the set marked `stamp`.
-  std::vector<std::vector<int>> components(std::span<const int> faces, int stamp) {
-    std::vector<std::vector<int>> comps;
+  Components components(std::span<const int> faces, int stamp) {
+    Components comps;
+    comps.faces.reserve(faces.size());
+    comps.start.push_back(0);
+    std::vector<int>& out = comps.faces;
     const int seen = new_stamp();
     for (int s : faces) {
       if (seen_[s] == seen) continue;
-      comps.emplace_back();
-      auto& c = comps.back();
       seen_[s] = seen;
-      c.push_back(s);
-      for (std::size_t k = 0; k < c.size(); ++k) {
-        for_each_neighbour(c[k], stamp, [&](int g) {
+      out.push_back(s);
+      for (std::size_t k = comps.start.back(); k < out.size(); ++k) {
+        for_each_neighbour(out[k], stamp, [&](int g) {
           if (seen_[g] != seen) {
             seen_[g] = seen;
-            c.push_back(g);
+            out.push_back(g);
           }
         });
       }
+      comps.start.push_back(static_cast<int>(out.size()));
     }
     return comps;
   }
@@ -178,6 +191,8 @@ class Builder {
       mark_set(f, stamp);
     auto comps = components(faces, stamp);
     std::vector<int> a, b;
+    a.reserve(count);
+    b.reserve(count);
     if (comps.size() > 1) {
       const int axis = longest_axis(first, count);
       std::vector<std::pair<double, int>> order;
@@ -260,7 +275,7 @@ class Builder {
       if (c == best) continue;
       a.insert(a.end(), comps[c].begin(), comps[c].end());
     }
-    if (!comps.empty()) b = comps[best];
+    if (comps.size() > 0) b.assign(comps[best].begin(), comps[best].end());
     // Deterministic order inside each half does not matter for correctness; sort for stability.
     std::sort(a.begin(), a.end());
     std::sort(b.begin(), b.end());
