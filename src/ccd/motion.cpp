@@ -81,6 +81,10 @@ double power_of_two(int k) {
 }
 
 double inverse_binade(double m) {
+  // The common case straight from the exponent bits: m normal and below 2^1021 (biased exponent
+  // 1..2044), so that 2^-e is a normal double too (the settle calls this once per kept query).
+  const std::uint64_t e = std::bit_cast<std::uint64_t>(m) >> 52;
+  if (e >= 1 && e <= 2044) return std::bit_cast<double>((2045 - e) << 52);
   return power_of_two(-binade_exponent(m));
 }
 

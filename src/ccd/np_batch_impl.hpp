@@ -33,14 +33,6 @@ B max_abs(const Vec3<B>& p) {
   return xsimd::max(xsimd::max(xsimd::abs(p.x), xsimd::abs(p.y)), xsimd::abs(p.z));
 }
 
-// motion.cpp's inverse_binade, without the call where the answer is in m's exponent bits alone:
-// m normal and below 2^1021 (biased exponent 1..2044), so that 2^-e is a normal double too.
-inline double scale_of(double m) {
-  const std::uint64_t e = std::bit_cast<std::uint64_t>(m) >> 52;
-  if (e >= 1 && e <= 2044) return std::bit_cast<double>((2045 - e) << 52);
-  return inverse_binade(m);
-}
-
 // Bit l of the result: lane l of m. One movemask on SSE2 and AVX2 (xsimd has no such accessor);
 // lane by lane elsewhere.
 template <class Arch>
@@ -278,7 +270,7 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
     alignas(64) double lane_top[W], lane_scale[W];
     top.store_aligned(lane_top);
     for (int l = 0; l < W; ++l)
-      lane_scale[l] = scale_of(lane_top[l]);
+      lane_scale[l] = inverse_binade(lane_top[l]);
     const B scale = B::load_aligned(lane_scale);
     V x0[4], x1[4];
     for (int p = 0; p < 4; ++p) {

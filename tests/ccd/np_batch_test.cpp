@@ -317,16 +317,12 @@ TEST(FastPathSettle, MissNoQueryInContactAndHitOnlyThose) {
 // make_motion's scale: std::frexp's exponent, applied with std::ldexp, for every magnitude.
 TEST(FastPathSettle, InverseBinadeIsFrexpAndLdexp) {
   Gen g(11);
-  std::vector<double> ms = {0.0,
-                            std::numeric_limits<double>::denorm_min(),
-                            std::numeric_limits<double>::min(),
-                            std::numeric_limits<double>::max(),
-                            0.5,
-                            1.0,
-                            std::nextafter(1.0, 0.0),
-                            0x1p-1022,
-                            0x1p-1023,
-                            0x1p1023};
+  std::vector<double> ms = {0.0, std::numeric_limits<double>::denorm_min(),
+                            std::numeric_limits<double>::min(), std::numeric_limits<double>::max(),
+                            0.5, 1.0, std::nextafter(1.0, 0.0), 0x1p-1022, 0x1p-1023, 0x1p1023,
+                            // Either side of the largest m whose scale comes from its bits alone.
+                            std::nextafter(0x1p1021, 0.0), 0x1p1021, std::nextafter(0x1p1022, 0.0),
+                            0x1p1022};
   for (int i = 0; i < 20000; ++i) {
     const double m = std::ldexp(g.uniform(0.5, 1.0), g.integer(-1080, 1024));
     if (std::isfinite(m)) ms.push_back(m);

@@ -15,6 +15,7 @@
 #include <tuple>
 
 #include "clothcd/core/error.hpp"
+#include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/oracle.hpp"
 #include "clothcd/experiment/experiment.hpp"
 #include "clothcd/mesh/io.hpp"
@@ -107,6 +108,16 @@ TEST(Experiment, RowsPerStepAndConfigurationSoundEqualsReference) {
         brute_force_detect(topo, seq.frames[key.second], seq.frames[key.second + 1]);
     EXPECT_EQ(r->vf_collisions, double(o.vf.size())) << key.first << " step " << key.second;
     EXPECT_EQ(r->ee_collisions, double(o.ee.size())) << key.first << " step " << key.second;
+    // The paper's narrow phase (no whole-triangle bound): its feature tests and NP culls.
+    DetectOptions paper;
+    paper.build = key.first == "spatial" ? BvhBuild::Spatial : BvhBuild::Patch;
+    paper.triangle_filter = false;
+    SelfDetector det(seq.faces, seq.num_vertices, seq.frames[0], paper);
+    const DetectStats s = det.detect(seq.frames[key.second], seq.frames[key.second + 1]).stats;
+    EXPECT_EQ(r->vf_tests, double(s.vf_tests)) << key.first << " step " << key.second;
+    EXPECT_EQ(r->ee_tests, double(s.ee_tests)) << key.first << " step " << key.second;
+    EXPECT_EQ(r->vf_np_culled, double(s.vf_np_culled)) << key.first << " step " << key.second;
+    EXPECT_EQ(r->ee_np_culled, double(s.ee_np_culled)) << key.first << " step " << key.second;
   }
   for (const auto& r : rows) {
     const StepRow& n = *ref.at({r.build, r.step});
