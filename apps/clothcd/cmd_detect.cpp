@@ -42,7 +42,7 @@ struct Args {
   int garment_vertices = -1;
   int threads = 0;
   int cull_min_triangles = 0;
-  bool verify = false, table = false, table_optimal = false, no_triangle_filter = false;
+  bool verify = false, table = false, table_optimal = false, no_distance_filter = false;
 };
 
 nlohmann::json stats_json(const DetectStats& s) {
@@ -174,7 +174,7 @@ using cli::missed_against;
 // Every build x culling mode x policy on one step, as a markdown table (misses and culled pairs
 // against `none` of the same build).
 void print_table(const TriangleMesh& w0, const TriangleMesh& w1, double thickness,
-                 bool with_optimal, bool triangle_filter) {
+                 bool with_optimal, bool distance_filter) {
   const Positions p0 = vertices_matrix(w0), p1 = vertices_matrix(w1);
   const BvhBuild builds[] = {BvhBuild::Spatial, BvhBuild::Patch};
   using research::ConeRule;
@@ -191,7 +191,7 @@ void print_table(const TriangleMesh& w0, const TriangleMesh& w1, double thicknes
     DetectOptions o;
     o.build = build;
     o.thickness = thickness;
-    o.triangle_filter = triangle_filter;
+    o.distance_filter = distance_filter;
     SelfDetector det(w0.faces, w0.num_vertices(), p0, o);
     const DetectResult none = det.detect(p0, p1);
     std::vector<Row> rows;
@@ -233,7 +233,7 @@ int run(const Args& a) {
   if (a.table && !a.json.empty()) throw InputError("--table writes no JSON; drop --json");
   o.thickness = a.thickness;
   o.cull_min_triangles = a.cull_min_triangles;
-  o.triangle_filter = !a.no_triangle_filter;
+  o.distance_filter = !a.no_distance_filter;
   o.research.verify = a.verify;
   const auto start = std::chrono::steady_clock::now();
   const auto since = [](std::chrono::steady_clock::time_point t) {
@@ -271,7 +271,7 @@ int run(const Args& a) {
                     static_cast<std::size_t>(a.threads));
   }
   if (a.table) {
-    print_table(w0, w1, a.thickness, a.table_optimal, !a.no_triangle_filter);
+    print_table(w0, w1, a.thickness, a.table_optimal, !a.no_distance_filter);
     return 0;
   }
   const double reading = since(start);
@@ -329,9 +329,10 @@ const bool registered = clothcd::app::register_command(
                      "sound culling tests only nodes of at least this many triangles (0: all; "
                      "same results, less work)");
       sub.add_option("--threads", a->threads, "worker threads (0: all)");
-      sub.add_flag("--no-triangle-filter", a->no_triangle_filter,
-                   "at zero thickness, test every triangle pair's feature pairs (the paper's "
-                   "narrow phase) instead of first dropping the pairs whose faces provably stay "
+      sub.add_flag("--no-distance-filter", a->no_distance_filter,
+                   "at zero thickness, skip the distance filter: test every triangle pair's "
+                   "feature pairs with the NP filter and the kernels (the paper's narrow phase) "
+                   "instead of first dropping the triangle and feature pairs that provably stay "
                    "apart");
       sub.add_flag("--verify", a->verify, "also run culling none and report missed collisions");
       sub.add_flag("--table", a->table,

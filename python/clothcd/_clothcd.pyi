@@ -85,7 +85,7 @@ class SelfDetector:
         reuse_distance: float = 0.0,
         cull_min_triangles: int = 0,
         reuse_front: bool = False,
-        triangle_filter: bool = True,
+        distance_filter: bool = True,
     ) -> None: ...
     def detect(self, V0: _Floats, V1: _Floats) -> DetectResult: ...
     def proximity(self, V: _Floats, h: float) -> ProximityResult: ...
@@ -107,7 +107,7 @@ class SelfDetector:
         verify: Optional[bool] = None,
         cull_min_triangles: Optional[int] = None,
         reuse_front: Optional[bool] = None,
-        triangle_filter: Optional[bool] = None,
+        distance_filter: Optional[bool] = None,
     ) -> None: ...
     @property
     def edges(self) -> _I32: ...
@@ -136,7 +136,7 @@ class PairDetector:
         toi_tolerance: float = 1e-4,
         distance_filter_depth: int = 0,
         reuse_front: bool = False,
-        triangle_filter: bool = True,
+        distance_filter: bool = True,
     ) -> None: ...
     def detect(self, Va0: _Floats, Va1: _Floats, Vb0: _Floats, Vb1: _Floats) -> PairDetectResult: ...
     @property

@@ -21,7 +21,7 @@ struct OptionArgs {
   std::optional<int> distance_filter_depth;
   std::optional<int> cull_min_triangles;
   std::optional<bool> reuse_front;
-  std::optional<bool> triangle_filter;
+  std::optional<bool> distance_filter;
 
   void apply(DetectOptions& o) const {
     // Research names included ("cone", "gated", "optimal"): they set DetectOptions::research.
@@ -45,7 +45,7 @@ struct OptionArgs {
       o.cull_min_triangles = *cull_min_triangles;
     }
     if (reuse_front) o.reuse_front = *reuse_front;
-    if (triangle_filter) o.triangle_filter = *triangle_filter;
+    if (distance_filter) o.distance_filter = *distance_filter;
   }
 };
 
@@ -56,7 +56,7 @@ py::dict options_dict(const DetectOptions& o, const char* bvh) {
   d["bvh"] = bvh;
   d["thickness"] = o.thickness;
   d["np_filter"] = o.np_filter;
-  d["triangle_filter"] = o.triangle_filter;
+  d["distance_filter"] = o.distance_filter;
   d["fast_path"] = o.fast_path;
   d["toi_tolerance"] = o.toi_tolerance;
   d["distance_filter_depth"] = o.distance_filter_depth;
@@ -321,7 +321,7 @@ Options (keyword-only):
   threads: worker threads (0: all cores).
   cull_min_triangles: "sound" tests only nodes of at least this many triangles (0: every node);
       the results are the same at any value, only the work changes (16 suits garments).
-  np_filter, triangle_filter, fast_path, toi_tolerance, distance_filter_depth, reuse_distance,
+  np_filter, distance_filter, fast_path, toi_tolerance, distance_filter_depth, reuse_distance,
       reuse_front: as the C++ DetectOptions.)";
 
 }  // namespace
@@ -387,7 +387,7 @@ seam): pairs joining them are not tested.)") +
                        std::string culling, std::string bvh, double thickness, int threads,
                        const ArrayLike& linked, bool np_filter, bool fast_path,
                        double toi_tolerance, int distance_filter_depth, double reuse_distance,
-                       int cull_min_triangles, bool reuse_front, bool triangle_filter) {
+                       int cull_min_triangles, bool reuse_front, bool distance_filter) {
              OptionArgs a{policy,
                           culling,
                           thickness,
@@ -398,7 +398,7 @@ seam): pairs joining them are not tested.)") +
                           distance_filter_depth,
                           cull_min_triangles,
                           reuse_front,
-                          triangle_filter};
+                          distance_filter};
              return std::make_unique<PySelfDetector>(F, V, bvh, a, threads, linked);
            }),
            py::arg("F"), py::arg("V_rest"), py::kw_only(), py::arg("policy") = "proposed",
@@ -408,7 +408,7 @@ seam): pairs joining them are not tested.)") +
            py::arg("toi_tolerance") = DetectOptions{}.toi_tolerance,
            py::arg("distance_filter_depth") = 0, py::arg("reuse_distance") = 0.0,
            py::arg("cull_min_triangles") = 0, py::arg("reuse_front") = false,
-           py::arg("triangle_filter") = DetectOptions{}.triangle_filter)
+           py::arg("distance_filter") = DetectOptions{}.distance_filter)
       .def("detect", &PySelfDetector::detect, py::arg("V0"), py::arg("V1"),
            R"(All vertex-face and edge-edge pairs that touch while every vertex moves linearly
 from V0 to V1 (both (n, 3)). Results are sorted and do not depend on the thread count. The GIL
@@ -432,10 +432,10 @@ changes when only these vertices move).)")
              std::optional<double> toi_tolerance, std::optional<int> distance_filter_depth,
              std::optional<double> reuse_distance, std::optional<bool> verify,
              std::optional<int> cull_min_triangles, std::optional<bool> reuse_front,
-             std::optional<bool> triangle_filter) {
+             std::optional<bool> distance_filter) {
             d.set_options(OptionArgs{policy, culling, thickness, toi_tolerance, reuse_distance,
                                      np_filter, fast_path, distance_filter_depth,
-                                     cull_min_triangles, reuse_front, triangle_filter},
+                                     cull_min_triangles, reuse_front, distance_filter},
                           verify);
           },
           py::kw_only(), py::arg("policy") = py::none(), py::arg("culling") = py::none(),
@@ -443,7 +443,7 @@ changes when only these vertices move).)")
           py::arg("fast_path") = py::none(), py::arg("toi_tolerance") = py::none(),
           py::arg("distance_filter_depth") = py::none(), py::arg("reuse_distance") = py::none(),
           py::arg("verify") = py::none(), py::arg("cull_min_triangles") = py::none(),
-          py::arg("reuse_front") = py::none(), py::arg("triangle_filter") = py::none(),
+          py::arg("reuse_front") = py::none(), py::arg("distance_filter") = py::none(),
           R"(Changes the options given (the tree build stays). verify=True also runs culling
 "none" and reports what this culling missed in DetectResult.missed_vf / missed_ee.)")
       .def_property_readonly("edges", &PySelfDetector::edges,
@@ -467,10 +467,10 @@ V_a, V_b: (n, 3) reference positions the trees are split on.)") +
                        const ArrayLike& Vb, std::string policy, std::string culling,
                        std::string bvh, double thickness, int threads, bool np_filter,
                        bool fast_path, double toi_tolerance, int distance_filter_depth,
-                       bool reuse_front, bool triangle_filter) {
+                       bool reuse_front, bool distance_filter) {
              OptionArgs a{policy,       culling,     thickness,      toi_tolerance,
                           std::nullopt, np_filter,   fast_path,      distance_filter_depth,
-                          std::nullopt, reuse_front, triangle_filter};
+                          std::nullopt, reuse_front, distance_filter};
              return std::make_unique<PyPairDetector>(Fa, Va, Fb, Vb, bvh, a, threads);
            }),
            py::arg("F_a"), py::arg("V_a"), py::arg("F_b"), py::arg("V_b"), py::kw_only(),
@@ -478,7 +478,7 @@ V_a, V_b: (n, 3) reference positions the trees are split on.)") +
            py::arg("thickness") = 0.0, py::arg("threads") = 0, py::arg("np_filter") = true,
            py::arg("fast_path") = true, py::arg("toi_tolerance") = DetectOptions{}.toi_tolerance,
            py::arg("distance_filter_depth") = 0, py::arg("reuse_front") = false,
-           py::arg("triangle_filter") = DetectOptions{}.triangle_filter)
+           py::arg("distance_filter") = DetectOptions{}.distance_filter)
       .def("detect", &PyPairDetector::detect, py::arg("Va0"), py::arg("Va1"), py::arg("Vb0"),
            py::arg("Vb1"),
            "Collisions while A moves linearly Va0 -> Va1 and B moves Vb0 -> Vb1 (GIL released).")

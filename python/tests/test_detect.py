@@ -209,19 +209,19 @@ def test_options_round_trip_and_verify():
     assert det.detect(V0, V1).missed_vf is None
 
 
-def test_triangle_filter_changes_the_work_not_the_results():
+def test_distance_filter_changes_the_work_not_the_results():
     F, V0, V1 = clothcd.procedural.crumpled_sheet(16, 3)
     on = clothcd.SelfDetector(F, V0, culling="sound")
-    assert on.options["triangle_filter"] is True
-    off = clothcd.SelfDetector(F, V0, culling="sound", triangle_filter=False)
-    assert off.options["triangle_filter"] is False
+    assert on.options["distance_filter"] is True
+    off = clothcd.SelfDetector(F, V0, culling="sound", distance_filter=False)
+    assert off.options["distance_filter"] is False
     a, b = on.detect(V0, V1), off.detect(V0, V1)
     assert np.array_equal(a.vf, b.vf) and np.array_equal(a.vf_toi, b.vf_toi)
     assert np.array_equal(a.ee, b.ee) and np.array_equal(a.ee_toi, b.ee_toi)
     # Off: every triangle pair's features are tested (none culled whole at zero thickness).
     assert b.stats["triangle_pairs_apart"] == 0 < a.stats["triangle_pairs_apart"]
     assert a.stats["ee_tests"] < b.stats["ee_tests"]
-    off.set_options(triangle_filter=True)
+    off.set_options(distance_filter=True)
     assert off.detect(V0, V1).stats["triangle_pairs_apart"] == a.stats["triangle_pairs_apart"]
 
 

@@ -3,6 +3,7 @@
 #include "ccd/certify.hpp"
 #include "ccd/fast_path.hpp"
 #include "ccd/isa.hpp"
+#include "clothcd/ccd/queries.hpp"
 
 // Without xsimd or off x86-64 (CLOTHCD_NP_BATCH_X86 unset) the batch runs the scalar filter.
 
@@ -16,6 +17,12 @@ void fast_path_settle_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict
 void fast_path_settle_avx2(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
                            FastSettled* settled, double* toi);
 void np_filter_batch_avx512(Kind kind, const NpBatch& b, NpVerdict* verdict);
+void distance_filter_batch_sse2(Kind kind, const NpBatch& b, double thickness, int depth,
+                                NpVerdict* verdict);
+void distance_filter_batch_avx2(Kind kind, const NpBatch& b, double thickness, int depth,
+                                NpVerdict* verdict);
+void distance_filter_batch_avx512(Kind kind, const NpBatch& b, double thickness, int depth,
+                                  NpVerdict* verdict);
 void fast_path_settle_avx512(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
                              FastSettled* settled, double* toi);
 #endif
@@ -31,6 +38,23 @@ void np_filter_batch_scalar(Kind kind, const NpBatch& b, NpVerdict* verdict) {
       points[k] = &p[k];
     }
     verdict[i] = unscaled_np_filter(kind, points);
+  }
+}
+
+void distance_filter_batch_scalar(Kind kind, const NpBatch& b, double thickness, int depth,
+                                  NpVerdict* verdict) {
+  for (int i = 0; i < b.size; ++i) {
+    if (verdict[i] != NpVerdict::Kept) continue;
+    Eigen::Vector3d p[8];
+    for (int k = 0; k < 8; ++k)
+      p[k] = {b.x[3 * k][i], b.x[3 * k + 1][i], b.x[3 * k + 2][i]};
+    const bool culled =
+        kind == Kind::VertexFace
+            ? distance_filter_culls(VertexFaceQuery{p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]},
+                                    thickness, depth)
+            : distance_filter_culls(EdgeEdgeQuery{p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]},
+                                    thickness, depth);
+    if (culled) verdict[i] = NpVerdict::Culled;
   }
 }
 
@@ -73,11 +97,16 @@ constexpr void (*const kNp[4])(Kind, const NpBatch&, NpVerdict*) = {
 constexpr void (*const kSettle[4])(Kind, const NpBatch&, const NpVerdict*, int, FastSettled*,
                                    double*) = {settle_batch_scalar, fast_path_settle_sse2,
                                                fast_path_settle_avx2, fast_path_settle_avx512};
+constexpr void (*const kDistance[4])(Kind, const NpBatch&, double, int, NpVerdict*) = {
+    distance_filter_batch_scalar, distance_filter_batch_sse2, distance_filter_batch_avx2,
+    distance_filter_batch_avx512};
 #else
 constexpr void (*const kNp[4])(Kind, const NpBatch&, NpVerdict*) = {np_filter_batch_scalar, nullptr,
                                                                     nullptr, nullptr};
 constexpr void (*const kSettle[4])(Kind, const NpBatch&, const NpVerdict*, int, FastSettled*,
                                    double*) = {settle_batch_scalar, nullptr, nullptr, nullptr};
+constexpr void (*const kDistance[4])(Kind, const NpBatch&, double, int, NpVerdict*) = {
+    distance_filter_batch_scalar, nullptr, nullptr, nullptr};
 #endif
 
 }  // namespace
@@ -95,6 +124,16 @@ bool fast_path_settle_with(int isa, Kind kind, const NpBatch& b, const NpVerdict
                            double toi_tolerance, FastSettled* settled, double* toi) {
   return isa >= 0 &&
          run_on(isa, kSettle, kind, b, verdict, toi_target_level(toi_tolerance), settled, toi);
+}
+
+void distance_filter_batch(Kind kind, const NpBatch& b, double thickness, int depth,
+                           NpVerdict* verdict) {
+  run_on(-1, kDistance, kind, b, thickness, depth, verdict);
+}
+
+bool distance_filter_batch_with(int isa, Kind kind, const NpBatch& b, double thickness, int depth,
+                                NpVerdict* verdict) {
+  return isa >= 0 && run_on(isa, kDistance, kind, b, thickness, depth, verdict);
 }
 
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict) {

@@ -39,6 +39,19 @@ void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict);
 /// lacks it.
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict);
 
+/// The distance filter on the queries the NP filter kept: verdict[i] becomes Culled where
+/// distance_filter_culls(query i, thickness, depth) holds, for each i < b.size whose verdict is
+/// Kept (such queries are finite). Uses the widest vector instructions the processor has; each lane
+/// performs the scalar filter's operations in their order (distance_filter.cpp, proximity.cpp),
+/// so every verdict is the scalar one.
+void distance_filter_batch(Kind kind, const NpBatch& b, double thickness, int depth,
+                           NpVerdict* verdict);
+
+/// The same with a fixed instruction set, for tests (as np_filter_batch_with; 0 runs
+/// distance_filter_culls per query).
+bool distance_filter_batch_with(int isa, Kind kind, const NpBatch& b, double thickness, int depth,
+                                NpVerdict* verdict);
+
 /// The depth (ranges of 2^-kSettleLevel of the step) to which fast_path_settle follows the
 /// search. On cloth_ball 92 -> 93, of 2.23 M kept queries (113,855 hits), 35 K are left over at
 /// depth 6 (247 K at depth 4, counting misses only); each costs the scalar kernel's whole search.

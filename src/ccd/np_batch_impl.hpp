@@ -174,6 +174,16 @@ void np_filter_batch_impl(Kind kind, const NpBatch& b, NpVerdict* verdict) {
   }
 }
 
+// The points of the n queries b.x[.][kept[l]] (n <= W; the lanes past n repeat the last), row by
+// row as in NpBatch: the kept queries' gather of the settle and the distance filter.
+template <int W>
+void gather_kept(const NpBatch& b, const int* kept, int n, double (&col)[24][W]) {
+  for (int r = 0; r < 24; ++r) {
+    for (int l = 0; l < W; ++l)
+      col[r][l] = b.x[r][kept[l < n ? l : n - 1]];
+  }
+}
+
 // fast_path_settle's working memory, one per thread: the per-query data of a batch and the time
 // ranges waiting for the inside test, a level at a time.
 struct SettleScratch {
@@ -257,10 +267,7 @@ void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict
   for (int s = 0; s < nk; s += W) {
     const int n = nk - s < W ? nk - s : W;
     alignas(64) double col[24][W];
-    for (int r = 0; r < 24; ++r) {
-      for (int l = 0; l < W; ++l)
-        col[r][l] = b.x[r][kept[s + (l < n ? l : n - 1)]];
-    }
+    gather_kept(b, kept + s, n, col);
     // make_motion: the largest |coordinate| and its power-of-two scale (inverse_binade, per lane).
     // Kept queries are finite with coordinate differences of at least 2^-300, so the largest
     // |coordinate| is positive and run() goes on to the cubic.

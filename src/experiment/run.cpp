@@ -31,7 +31,7 @@ constexpr double kDeg = 180.0 / std::numbers::pi;
 DetectOptions paper_options(BvhBuild build) {
   DetectOptions o;
   o.build = build;
-  o.triangle_filter = false;
+  o.distance_filter = false;
   return o;
 }
 

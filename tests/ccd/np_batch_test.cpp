@@ -3,7 +3,8 @@
 // near-coplanar and exactly coplanar ones, out-of-range magnitudes and non-finite coordinates;
 // and no culled query that the exact oracle finds in contact. Likewise fast_path_settle against
 // its scalar reference and the kernel, its misses and certified hits against the exact oracle;
-// and make_motion's scale and coordinates against their definitions.
+// and make_motion's scale and coordinates against their definitions. The batched distance filter
+// against distance_filter_culls, and its culls against the exact oracle.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 
 #include "ccd/motion.hpp"
 #include "ccd/np_batch.hpp"
+#include "clothcd/ccd/proximity.hpp"
 #include "exact_oracle.hpp"
 #include "support/random_gen.hpp"
 
@@ -312,6 +314,181 @@ TEST(FastPathSettle, MissNoQueryInContactAndHitOnlyThose) {
   }
   EXPECT_GT(n.missed, 50);
   EXPECT_GT(n.hits, 10);
+}
+
+// Every instruction set gives distance_filter_culls' verdicts on `qs` (at most a batch), the
+// finite queries marked Kept and every third of them left Culled or Undecided (never to be
+// touched). Returns the scalar verdicts; counts the finite queries in `tested`.
+std::vector<NpVerdict> check_distance(Kind kind, const std::vector<Points>& qs, double thickness,
+                                      int depth, int& tested) {
+  NpBatch b;
+  fill(b, qs);
+  std::vector<NpVerdict> given(qs.size());
+  for (std::size_t i = 0; i < qs.size(); ++i) {
+    const bool finite =
+        std::all_of(qs[i].begin(), qs[i].end(), [](const V& x) { return x.allFinite(); });
+    const NpVerdict other = i % 2 == 0 ? NpVerdict::Culled : NpVerdict::Undecided;
+    given[i] = finite && i % 3 != 0 ? NpVerdict::Kept : other;
+    tested += given[i] == NpVerdict::Kept;
+  }
+  std::vector<NpVerdict> expect = given, got;
+  EXPECT_TRUE(ccd_detail::distance_filter_batch_with(0, kind, b, thickness, depth, expect.data()));
+  for (std::size_t i = 0; i < qs.size(); ++i) {
+    if (given[i] != NpVerdict::Kept) continue;
+    const bool culls = kind == Kind::VertexFace
+                           ? distance_filter_culls(vf_query(qs[i]), thickness, depth)
+                           : distance_filter_culls(ee_query(qs[i]), thickness, depth);
+    EXPECT_EQ(expect[i], culls ? NpVerdict::Culled : NpVerdict::Kept) << "query " << i;
+  }
+  for (int isa = 1; isa <= 4; ++isa) {
+    got = given;
+    if (isa < 4) {
+      if (!ccd_detail::distance_filter_batch_with(isa, kind, b, thickness, depth, got.data())) {
+        continue;
+      }
+    } else {
+      ccd_detail::distance_filter_batch(kind, b, thickness, depth, got.data());
+    }
+    for (std::size_t i = 0; i < qs.size(); ++i)
+      EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " depth " << depth << " query " << i;
+  }
+  return expect;
+}
+
+TEST(DistanceFilterBatch, MatchesTheScalarFilterOnRandomQueries) {
+  int tested = 0, culled = 0;
+  for (std::uint64_t seed = 500; seed < 540; ++seed) {
+    Gen g(seed);
+    for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
+      std::vector<Points> qs;
+      const int size = seed % 2 == 0 ? NpBatch::kCapacity : g.integer(1, NpBatch::kCapacity);
+      for (int i = 0; i < size; ++i) {
+        Points p = make_query(g, g.integer(0, 5));
+        if (g.integer(0, 9) == 0) p[g.integer(0, 7)] = p[g.integer(0, 7)];  // a repeated point
+        if (g.integer(0, 19) == 0) {  // a degenerate feature: all its points on one line
+          for (int k = 1; k < 4; ++k)
+            p[k] = p[0] + (k * 0.25) * (p[4] - p[0]);
+        }
+        qs.push_back(p);
+      }
+      const double thickness = seed % 4 == 0 ? std::ldexp(1.0, -g.integer(2, 30)) : 0.0;
+      const std::vector<NpVerdict> v = check_distance(kind, qs, thickness, int(seed % 4), tested);
+      culled += static_cast<int>(std::count(v.begin(), v.end(), NpVerdict::Culled));
+    }
+  }
+  // Both verdicts occur often, so each lane path was compared.
+  EXPECT_GT(tested, 2000);
+  EXPECT_GT(culled, 1000);
+}
+
+TEST(DistanceFilterBatch, CullsNoQueryInContact) {
+  int culled = 0;
+  for (std::uint64_t seed = 540; seed < 546; ++seed) {
+    Gen g(seed);
+    for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
+      std::vector<Points> qs;
+      for (int i = 0; i < 96; ++i)
+        qs.push_back(make_query(g, g.integer(1, 3)));  // the families with contacts
+      for (int i = 0; i < 32; ++i)
+        qs.push_back(sliding_coplanar(g, kind));
+      int tested = 0;
+      const std::vector<NpVerdict> v = check_distance(kind, qs, 0.0, 2, tested);
+      for (std::size_t i = 0; i < qs.size(); ++i) {
+        if (v[i] != NpVerdict::Culled || i % 3 == 0) continue;  // culled by the filter
+        ++culled;
+        EXPECT_FALSE(exact_contact(kind, qs[i])) << "seed " << seed << " query " << i;
+      }
+    }
+  }
+  EXPECT_GT(culled, 100);
+}
+
+// The filter's bound at depth 0, (d0 + d1 - D) / 2 with the distances or with their lower
+// bounds, and its slack, computed as distance_filter.cpp does.
+struct Bounds {
+  double exact, lower, slack;
+};
+Bounds filter_bounds(Kind kind, const Points& p) {
+  const auto dist = [&](int o) {
+    return kind == Kind::VertexFace
+               ? point_triangle_proximity(p[o], p[o + 1], p[o + 2], p[o + 3]).distance
+               : edge_edge_proximity(p[o], p[o + 1], p[o + 2], p[o + 3]).distance;
+  };
+  const auto lower = [&](int o) {
+    return kind == Kind::VertexFace
+               ? point_triangle_distance_lower_bound(p[o], p[o + 1], p[o + 2], p[o + 3])
+               : edge_edge_distance_lower_bound(p[o], p[o + 1], p[o + 2], p[o + 3]);
+  };
+  const int first = kind == Kind::VertexFace ? 1 : 2;
+  double move = 0.0, top = 1.0;
+  for (int i = 0; i < first; ++i) {
+    for (int j = first; j < 4; ++j)
+      move = std::max(move, ((p[i + 4] - p[i]) - (p[j + 4] - p[j])).squaredNorm());
+  }
+  for (const V& x : p)
+    top = std::max(top, x.cwiseAbs().maxCoeff());
+  move = std::sqrt(move);
+  return {0.5 * (dist(0) + dist(4) - move), 0.5 * (lower(0) + lower(4) - move), 1e-12 * top};
+}
+
+// Makes the face (VF) nearly a segment, or the edges (EE) nearly parallel, at both times, the
+// sine of the angle at the face's first corner, or between the edges, about the distances'
+// thresholds for trusting the interior solution (1e-6 for a face, 1e-7 for two edges), either
+// side; the vertex above the face's interior, the second edge crossing over the first's middle,
+// so that the interior solution is the nearest candidate where it counts.
+void thin(Gen& g, Kind kind, Points& p) {
+  const double sine = (kind == Kind::VertexFace ? 1e-6 : 1e-7) * g.uniform(0.5, 2.0);
+  const double along = g.uniform(0.2, 0.8), above = g.uniform(0.01, 0.5);
+  for (const int o : {0, 4}) {
+    if (kind == Kind::VertexFace) {
+      const V a = p[o + 1], u = p[o + 2] - a;
+      const V side = u.cross(V(0.3, -0.5, 0.8)).normalized() * u.norm();
+      p[o + 3] = a + along * u + along * sine * side;
+      p[o] = a + 0.5 * along * u + 0.25 * along * sine * side + above * u.cross(side) / u.norm();
+    } else {
+      const V a = p[o], u = p[o + 1] - a;
+      const V side = u.cross(V(0.3, -0.5, 0.8)).normalized() * u.norm();
+      p[o + 2] =
+          a + 0.5 * (1 - along) * u - 0.5 * along * sine * side + above * u.cross(side) / u.norm();
+      p[o + 3] = p[o + 2] + along * u + along * sine * side;
+    }
+  }
+}
+
+// At thicknesses that put the verdict on the last bit of either bound (one query per batch), so
+// that any difference in a lane's rounding of the distances or slack shows, and any verdict that
+// the scalar filter's first try with the lower bounds decides and the lanes' distances do not.
+TEST(DistanceFilterBatch, MatchesTheScalarFilterAtItsThreshold) {
+  int tested = 0, flips = 0;
+  for (std::uint64_t seed = 560; seed < 580; ++seed) {
+    Gen g(seed);
+    for (const Kind kind : {Kind::VertexFace, Kind::EdgeEdge}) {
+      for (int i = 0; i < 40; ++i) {
+        Points p = make_query(g, g.integer(0, 4));
+        if (i % 2 == 0) {
+          Points q = p;  // moving little, so that the bound is positive
+          for (int k = 0; k < 4; ++k)
+            q[k + 4] = q[k] + g.vec(1e-3 * (q[1] - q[0]).norm());
+          thin(g, kind, q);
+          if (std::all_of(q.begin(), q.end(), [](const V& x) { return x.allFinite(); })) p = q;
+        }
+        const Bounds b = filter_bounds(kind, p);
+        for (const double bound : {b.exact, b.lower}) {
+          if (!(std::isfinite(bound) && bound > b.slack)) continue;
+          const double t = bound - b.slack;
+          std::vector<NpVerdict> at;
+          for (const double th : {std::nextafter(t, 0.0), t, std::nextafter(t, INFINITY)}) {
+            int n = 0;
+            at.push_back(check_distance(kind, {p, p}, th, 0, n)[1]);
+            tested += n;
+          }
+          flips += at.front() != at.back();
+        }
+      }
+    }
+  }
+  EXPECT_GT(tested, 1000);
+  EXPECT_GT(flips, 300);  // the thresholds were reached
 }
 
 // make_motion's scale: std::frexp's exponent, applied with std::ldexp, for every magnitude.

@@ -60,7 +60,7 @@ TEST(Candidates, KernelsOnTheCandidatesFindWhatTheDetectorFinds) {
       SCOPED_TRACE(::testing::Message() << s.name << " linked " << linked);
       DetectOptions o;
       o.culling = Culling::None;
-      o.triangle_filter = false;  // every overlapping feature pair reaches the feature tests
+      o.distance_filter = false;  // every overlapping feature pair reaches the feature tests
       if (linked) {               // link some vertices far apart in the mesh, as seams do
         for (int v = 0; v + 7 < s.num_vertices; v += 13)
           o.linked_vertices.emplace_back(v, s.num_vertices - 1 - v);
@@ -73,15 +73,24 @@ TEST(Candidates, KernelsOnTheCandidatesFindWhatTheDetectorFinds) {
       const auto triangle_pairs = overlapping_leaf_pairs(detector.bvh());
       const FeaturePairs all = candidates(triangle_pairs);
       // The detector tests exactly the candidates whose swept feature boxes overlap.
-      std::uint64_t vf_tests = 0, ee_tests = 0;
+      // Of them, those the filters cull with DetectOptions::distance_filter: the NP filter, and
+      // the distance filter (two bisections) on what the NP filter keeps.
+      std::uint64_t vf_tests = 0, ee_tests = 0, vf_filtered = 0, ee_filtered = 0;
+      const auto filtered = [](const auto& q) {
+        return np_filter_culls(q) || distance_filter_culls(q, 0.0, 2);
+      };
       for (auto [v, f] : all.vf) {
         const Face& t = topo.faces()[f];
         const Eigen::Vector3d p0 = row(s.v_t0, v), p1 = row(s.v_t1, v);
         const Eigen::Vector3d a0 = row(s.v_t0, t[0]), b0 = row(s.v_t0, t[1]),
                               c0 = row(s.v_t0, t[2]), a1 = row(s.v_t1, t[0]),
                               b1 = row(s.v_t1, t[1]), c1 = row(s.v_t1, t[2]);
-        vf_tests += overlap(swept_feature_box({&p0, &p1}, 0.0),
-                            swept_feature_box({&a0, &b0, &c0, &a1, &b1, &c1}, 0.0));
+        if (!overlap(swept_feature_box({&p0, &p1}, 0.0),
+                     swept_feature_box({&a0, &b0, &c0, &a1, &b1, &c1}, 0.0))) {
+          continue;
+        }
+        ++vf_tests;
+        vf_filtered += filtered(VertexFaceQuery{p0, a0, b0, c0, p1, a1, b1, c1});
       }
       for (auto [ea, eb] : all.ee) {
         const Edge &a = topo.edges()[ea], &b = topo.edges()[eb];
@@ -89,24 +98,34 @@ TEST(Candidates, KernelsOnTheCandidatesFindWhatTheDetectorFinds) {
                               a10 = row(s.v_t1, a[0]), a11 = row(s.v_t1, a[1]);
         const Eigen::Vector3d b00 = row(s.v_t0, b[0]), b01 = row(s.v_t0, b[1]),
                               b10 = row(s.v_t1, b[0]), b11 = row(s.v_t1, b[1]);
-        ee_tests += overlap(swept_feature_box({&a00, &a01, &a10, &a11}, 0.0),
-                            swept_feature_box({&b00, &b01, &b10, &b11}, 0.0));
+        if (!overlap(swept_feature_box({&a00, &a01, &a10, &a11}, 0.0),
+                     swept_feature_box({&b00, &b01, &b10, &b11}, 0.0))) {
+          continue;
+        }
+        ++ee_tests;
+        ee_filtered += filtered(EdgeEdgeQuery{a00, a01, b00, b01, a10, a11, b10, b11});
       }
       EXPECT_EQ(vf_tests, expected.stats.vf_tests);
       EXPECT_EQ(ee_tests, expected.stats.ee_tests);
       const DetectResult got = run_kernels(topo, s.v_t0, s.v_t1, all, o);
       EXPECT_EQ(got.vf, expected.vf);
       EXPECT_EQ(got.ee, expected.ee);
-      // The whole-triangle bound first drops triangle pairs that never touch: the same
-      // collisions from fewer feature tests.
+      // With the distance filter the whole-triangle bound first drops triangle pairs that never
+      // touch, then the feature bound culls what the NP filter keeps: the same collisions from
+      // fewer feature tests. Each feature pair of a dropped triangle pair is one the feature
+      // bound culls, so the dropped tests and the culls add up to the filters' culls above.
       DetectOptions with = o;
-      with.triangle_filter = true;
-      SelfDetector filtered(s.faces, s.num_vertices, s.v_t0, with);
-      const DetectResult f = filtered.detect(s.v_t0, s.v_t1);
+      with.distance_filter = true;
+      SelfDetector filtering(s.faces, s.num_vertices, s.v_t0, with);
+      const DetectResult f = filtering.detect(s.v_t0, s.v_t1);
       EXPECT_EQ(f.vf, expected.vf);
       EXPECT_EQ(f.ee, expected.ee);
       EXPECT_GT(f.stats.triangle_pairs_apart, 0u);
       EXPECT_LT(f.stats.vf_tests + f.stats.ee_tests, vf_tests + ee_tests);
+      EXPECT_EQ(vf_tests - f.stats.vf_tests + f.stats.vf_np_culled, vf_filtered);
+      EXPECT_EQ(ee_tests - f.stats.ee_tests + f.stats.ee_np_culled, ee_filtered);
+      EXPECT_GT(vf_filtered + ee_filtered,
+                expected.stats.vf_np_culled + expected.stats.ee_np_culled);
 
       // Each feature pair once: per triangle pair, unsorted, no repeats, none an orphan.
       FeaturePairs owned;

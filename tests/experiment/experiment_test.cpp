@@ -111,7 +111,7 @@ TEST(Experiment, RowsPerStepAndConfigurationSoundEqualsReference) {
     // The paper's narrow phase (no whole-triangle bound): its feature tests and NP culls.
     DetectOptions paper;
     paper.build = key.first == "spatial" ? BvhBuild::Spatial : BvhBuild::Patch;
-    paper.triangle_filter = false;
+    paper.distance_filter = false;
     SelfDetector det(seq.faces, seq.num_vertices, seq.frames[0], paper);
     const DetectStats s = det.detect(seq.frames[key.second], seq.frames[key.second + 1]).stats;
     EXPECT_EQ(r->vf_tests, double(s.vf_tests)) << key.first << " step " << key.second;

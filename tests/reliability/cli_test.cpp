@@ -216,13 +216,13 @@ TEST(CliDetect, JsonHoldsTheDetectorsCollisionsExactly) {
 TEST(CliDetect, ThicknessReportsTrianglePairsCulledWhole) {
   // The whole-triangle distance bound culls whole triangle pairs first: the count is in the JSON
   // and the summary. With a thickness it is part of the distance filter; at zero thickness it
-  // runs unless --no-triangle-filter asks for the cubic filter alone (then the count is 0), and
+  // runs unless --no-distance-filter asks for the cubic filter alone (then the count is 0), and
   // the collisions are the same either way.
   CliScratch dir;
   write_step(dir);
   std::map<std::string, nlohmann::json> out;
   for (const char* args :
-       {"--thickness 0", "--thickness 0 --no-triangle-filter", "--thickness 0.001"}) {
+       {"--thickness 0", "--thickness 0 --no-distance-filter", "--thickness 0.001"}) {
     SCOPED_TRACE(args);
     const auto r =
         dir.run(std::string("detect --t0 t0.obj --t1 t1.obj ") + args + " --json out.json");
@@ -232,7 +232,7 @@ TEST(CliDetect, ThicknessReportsTrianglePairsCulledWhole) {
     const auto pairs = j["stats"]["triangle_pairs"].get<std::uint64_t>();
     EXPECT_NE(r.out.find("culled whole by the triangle distance bound"), std::string::npos)
         << r.out;
-    if (std::string(args).find("--no-triangle-filter") != std::string::npos) {
+    if (std::string(args).find("--no-distance-filter") != std::string::npos) {
       EXPECT_EQ(apart, 0u);
     } else {
       EXPECT_GT(apart, 0u);
@@ -241,7 +241,7 @@ TEST(CliDetect, ThicknessReportsTrianglePairsCulledWhole) {
     out[args] = j;
   }
   const auto& with = out["--thickness 0"];
-  const auto& without = out["--thickness 0 --no-triangle-filter"];
+  const auto& without = out["--thickness 0 --no-distance-filter"];
   EXPECT_EQ(with["vf"], without["vf"]);
   EXPECT_EQ(with["ee"], without["ee"]);
   EXPECT_EQ(with["stats"]["triangle_pairs"], without["stats"]["triangle_pairs"]);

@@ -38,15 +38,16 @@ struct DetectOptions {
   double thickness = 0.0;
   /// Deforming NP filter before the kernels (applied at zero thickness only).
   bool np_filter = true;
-  /// At zero thickness (with np_filter), a triangle pair whose two faces provably never touch
-  /// over the step is dropped before its feature pairs are tested: the whole-triangle bound of
-  /// the distance filter (distance_filter_culls for a TriangleTriangleQuery, thickness 0), which
-  /// with a thickness always runs as part of that filter. Every collision is still reported;
+  /// At zero thickness (with np_filter), the distance filter runs too, as it always does with a
+  /// thickness: a triangle pair whose two faces provably never touch over the step is dropped
+  /// before its feature pairs are tested (the whole-triangle bound, distance_filter_culls for a
+  /// TriangleTriangleQuery; DetectStats::triangle_pairs_apart counts them), and a feature pair the
+  /// NP filter keeps is dropped where distance_filter_culls (thickness 0, two bisections) proves
+  /// its features apart (counted with the NP filter's culls). Every collision is still reported;
   /// since the kernels certify a hit to within their tolerance (see thickness), a near miss they
-  /// would report may be dropped where the bound proves the faces apart. Fewer feature tests
-  /// (DetectStats::triangle_pairs_apart counts the pairs dropped); off, the narrow phase is the
-  /// paper's (NP filter, then kernels).
-  bool triangle_filter = true;
+  /// would report may be dropped where a bound proves the features apart. Fewer feature tests and
+  /// kernel searches; off, the narrow phase is the paper's (NP filter, then kernels).
+  bool distance_filter = true;
   /// CcdOptions::fast_path of the kernels.
   bool fast_path = true;
   /// CcdOptions::toi_tolerance of the kernels: how closely a hit's time of impact is refined
@@ -99,11 +100,13 @@ struct DetectStats {
   std::uint64_t adjacent_pairs = 0;  ///< overlapping vertex-sharing leaf pairs (left to orphans)
   std::uint64_t triangle_pairs = 0;  ///< non-adjacent triangle pairs reaching the narrow phase
   /// ... of which culled whole by the whole-triangle distance bound (thickness > 0, or
-  /// DetectOptions::triangle_filter), their features untested
+  /// DetectOptions::distance_filter), their features untested
   std::uint64_t triangle_pairs_apart = 0;
   std::uint64_t vf_tests = 0;  ///< VF feature pairs past the feature box test (incl. orphans)
   std::uint64_t ee_tests = 0;
-  std::uint64_t vf_np_culled = 0;  ///< ... of which the NP filter culled
+  /// ... of which the filters culled: the NP filter (zero thickness), the distance filter (with a
+  /// thickness, or after the NP filter with DetectOptions::distance_filter)
+  std::uint64_t vf_np_culled = 0;
   std::uint64_t ee_np_culled = 0;
   std::uint64_t vf_orphans = 0;  ///< orphan feature pairs checked (all of them, every step)
   std::uint64_t ee_orphans = 0;
