@@ -5,8 +5,8 @@
 // distance_filter_culls (distance_filter.cpp, with the distances of proximity.cpp) in their
 // order, a select standing for each branch, so every verdict is the scalar one. It leaves out the
 // scalar filter's first try with the distances' lower bounds: where that culls, the distances
-// cull too (queries.hpp), so the verdict is the same without it. min_of and max_of select as
-// std::min and std::max do (xsimd::min and max differ on NaN).
+// cull too (queries.hpp), so the verdict is the same without it. min_of and max_of (lanes.hpp)
+// select as std::min and std::max do.
 
 #include <xsimd/xsimd.hpp>
 
@@ -19,14 +19,8 @@ namespace clothcd::ccd_detail {
 namespace NP_BATCH_NAMESPACE {
 namespace distance {
 
-template <class B>
-B min_of(const B& a, const B& b) {  // std::min(a, b)
-  return xsimd::select(b < a, b, a);
-}
-template <class B>
-B max_of(const B& a, const B& b) {  // std::max(a, b)
-  return xsimd::select(a < b, b, a);
-}
+using lanes::max_of;
+using lanes::min_of;
 
 // p + s (q - p), coordinate by coordinate (Eigen's p + s * (q - p)).
 template <class B>

@@ -16,26 +16,16 @@
 namespace clothcd::detail {
 namespace FACE_BOUNDS_NAMESPACE {
 
-// The scalar forms of the lane operations; a batch finds its own (xsimd's) by argument lookup.
-inline double select(bool m, double a, double b) {
-  return m ? a : b;
-}
-
 // The 3-vector of lanes and its operations (lanes.hpp).
 template <class T>
 using P3 = ccd_detail::lanes::Vec3<T>;
 using ccd_detail::lanes::cross;
 using ccd_detail::lanes::dot;
+using ccd_detail::lanes::max_of;
+using ccd_detail::lanes::min_of;
+using ccd_detail::lanes::select;
 using ccd_detail::lanes::sub;
 
-template <class T>
-T min_of(const T& a, const T& b) {  // std::min(a, b)
-  return select(b < a, b, a);
-}
-template <class T>
-T max_of(const T& a, const T& b) {  // std::max(a, b)
-  return select(a < b, b, a);
-}
 template <class T>
 P3<T> min_of(const P3<T>& p, const P3<T>& q) {
   return {min_of(p.x, q.x), min_of(p.y, q.y), min_of(p.z, q.z)};

@@ -289,7 +289,7 @@ struct FeatureContext {
   }
 
   /// Whether the distance filter is the one in use (thickness > 0, filters on).
-  [[nodiscard]] bool distance_filter() const { return np_filter && ccd.thickness > 0; }
+  [[nodiscard]] bool distance_at_thickness() const { return np_filter && ccd.thickness > 0; }
   /// Whether triangle pairs go through the whole-triangle distance bound first: with the distance
   /// filter, or at zero thickness with DetectOptions::distance_filter.
   [[nodiscard]] bool faces_apart_filter() const {
@@ -321,7 +321,7 @@ struct FeatureContext {
     // At zero thickness the distance filter tests what the NP filter keeps, as in the batches
     // (whose kept pairs arrive here np_kept, already through it).
     if ((separate_np() && !np_kept && np_filter_culls(q)) ||
-        (distance_filter() && distance_filter_culls(q, ccd.thickness, distance_depth)) ||
+        (distance_at_thickness() && distance_filter_culls(q, ccd.thickness, distance_depth)) ||
         (distance_at_zero() && !np_kept && !np_filter_culls(q) &&
          distance_filter_culls(q, 0.0, kZeroThicknessDepth))) {
       ++culled;
@@ -333,23 +333,29 @@ struct FeatureContext {
     return r.hit;
   }
 
-  // A culled pair counts as culled by the NP filter where ccd_hit counts it so: always for the
-  // separate filter, with the fast path where the NP filter is on (counted_np). With the fast
-  // path (batched_np() implies zero thickness), the kept pairs that fast_path_settle settles are
-  // the kernel's misses on path FastPath (nothing to count or report) and its certified hits
-  // (reported with the kernel's time of impact).
+  // The batch's filters in ccd_test's order: the NP filter, the distance filter on what it keeps
+  // (distance_at_zero), and with the fast path the kernel's own search down to kSettleLevel.
+  void filter_batch(ccd_detail::Kind kind, const ccd_detail::NpBatch& q, FeatureBatch& b) const {
+    ccd_detail::np_filter_batch(kind, q, b.verdict.data());
+    if (distance_at_zero()) {
+      ccd_detail::distance_filter_batch(kind, q, 0.0, kZeroThicknessDepth, b.verdict.data());
+    }
+    if (ccd.fast_path) {
+      ccd_detail::fast_path_settle(kind, q, b.verdict.data(), ccd.toi_tolerance, b.settled.data(),
+                                   b.toi.data());
+    }
+  }
+
+  // A culled pair (by the NP filter, or by the distance filter after it) counts as culled by the
+  // NP filter where ccd_hit counts it so: always for the separate filter, with the fast path
+  // where the NP filter is on (counted_np). With the fast path (batched_np() implies zero
+  // thickness), the kept pairs that fast_path_settle settles are the kernel's misses on path
+  // FastPath (nothing to count or report) and its certified hits (reported with the kernel's
+  // time of impact).
   void flush_vf(FeatureBatch& b, FeatureCounters& c, std::vector<VertexFaceCollision>& out) const {
     if (b.vf.size == 0) return;
-    ccd_detail::np_filter_batch(ccd_detail::Kind::VertexFace, b.vf, b.verdict.data());
-    if (distance_at_zero()) {
-      ccd_detail::distance_filter_batch(ccd_detail::Kind::VertexFace, b.vf, 0.0,
-                                        kZeroThicknessDepth, b.verdict.data());
-    }
+    filter_batch(ccd_detail::Kind::VertexFace, b.vf, b);
     const bool settle = ccd.fast_path;
-    if (settle) {
-      ccd_detail::fast_path_settle(ccd_detail::Kind::VertexFace, b.vf, b.verdict.data(),
-                                   ccd.toi_tolerance, b.settled.data(), b.toi.data());
-    }
     for (int i = 0; i < b.vf.size; ++i) {
       ++c.vf_tests;
       if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
@@ -372,16 +378,8 @@ struct FeatureContext {
   }
   void flush_ee(FeatureBatch& b, FeatureCounters& c, std::vector<EdgeEdgeCollision>& out) const {
     if (b.ee.size == 0) return;
-    ccd_detail::np_filter_batch(ccd_detail::Kind::EdgeEdge, b.ee, b.verdict.data());
-    if (distance_at_zero()) {
-      ccd_detail::distance_filter_batch(ccd_detail::Kind::EdgeEdge, b.ee, 0.0, kZeroThicknessDepth,
-                                        b.verdict.data());
-    }
+    filter_batch(ccd_detail::Kind::EdgeEdge, b.ee, b);
     const bool settle = ccd.fast_path;
-    if (settle) {
-      ccd_detail::fast_path_settle(ccd_detail::Kind::EdgeEdge, b.ee, b.verdict.data(),
-                                   ccd.toi_tolerance, b.settled.data(), b.toi.data());
-    }
     for (int i = 0; i < b.ee.size; ++i) {
       ++c.ee_tests;
       if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
@@ -410,7 +408,7 @@ struct FeatureContext {
     return np_filter && ccd.thickness == 0 && !ccd.fast_path;
   }
   // With a thickness the cubic filter does not apply; the distance bound takes its place (it
-  // culls resting contact, the bulk of a simulator's pairs): see distance_filter().
+  // culls resting contact, the bulk of a simulator's pairs): see distance_at_thickness().
   static CcdResult ccd_kernel(const VertexFaceQuery& q, const CcdOptions& o) {
     return vertex_face_ccd(q, o);
   }
