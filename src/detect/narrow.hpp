@@ -62,8 +62,9 @@ struct FeatureCounters {
   }
 };
 
-/// Feature pairs waiting for the NP filter, which FeatureContext::queue_vf and queue_ee run a
-/// batch at a time (vectorised, np_batch.hpp); one per thread.
+/// Feature pairs waiting for the vectorised filters (np_batch.hpp: the NP filter at zero
+/// thickness, the distance filter at a thickness), which FeatureContext::queue_vf and queue_ee
+/// run a batch at a time; one per thread.
 struct FeatureBatch {
   static constexpr int kCapacity = ccd_detail::NpBatch::kCapacity;
   ccd_detail::NpBatch vf, ee;  // gathered positions
@@ -71,7 +72,30 @@ struct FeatureBatch {
   std::array<ccd_detail::NpVerdict, kCapacity> verdict;
   std::array<ccd_detail::FastSettled, kCapacity> settled;  // ccd_detail::fast_path_settle
   std::array<double, kCapacity> toi;
+
+  /// Queues the VF pair `ids` (vertex, face) with its 8 points (vf_points); true when full.
+  bool push_vf(std::pair<int, int> ids, const std::array<const double*, 8>& points) {
+    vf_ids[vf.size] = ids;
+    vf.push(points);
+    return vf.full();
+  }
+  /// Queues the EE pair `ids` with its 8 points (ee_points); true when full.
+  bool push_ee(std::pair<int, int> ids, const std::array<const double*, 8>& points) {
+    ee_ids[ee.size] = ids;
+    ee.push(points);
+    return ee.full();
+  }
 };
+
+/// The query of a batch's i-th pair, read back from its gathered positions: the query that
+/// was queued, bit for bit.
+template <class Query>
+Query query_at(const ccd_detail::NpBatch& b, int i) {
+  const auto point = [&](int p) {
+    return Eigen::Vector3d(b.x[3 * p][i], b.x[3 * p + 1][i], b.x[3 * p + 2][i]);
+  };
+  return Query{point(0), point(1), point(2), point(3), point(4), point(5), point(6), point(7)};
+}
 
 /// Triangle pairs waiting for the whole-triangle distance filter (triangles_filter_culls: where
 /// it culls, it culls all 15 feature pairs of the two faces; a pair of layers resting on each
@@ -234,9 +258,9 @@ struct FeatureContext {
     if (ccd_hit(q, c.ee_tests, c.ee_np, toi)) out.push_back({ea, eb, a, b, toi});
   }
 
-  /// kernel_vf deferred to a batch: the pairs the batched NP filter culls are counted as kernel_vf
-  /// counts them, the others go through kernel_vf's path. Without a cubic NP filter in the
-  /// settings, kernel_vf at once. `flush` tests what is left.
+  /// kernel_vf deferred to a batch: the pairs the batched filters cull are counted as kernel_vf
+  /// counts them, the others go through kernel_vf's path. Without a vectorised filter in the
+  /// settings (batched()), kernel_vf at once. `flush` tests what is left.
   void queue_vf(int v, int f, FeatureBatch& b, FeatureCounters& c,
                 std::vector<VertexFaceCollision>& out) const {
     queue_vf(v, f, topo->faces()[f], b, c, out);
@@ -244,15 +268,12 @@ struct FeatureContext {
   /// The same, given f's corners `t` (topo->faces()[f]).
   void queue_vf(int v, int f, const Face& t, FeatureBatch& b, FeatureCounters& c,
                 std::vector<VertexFaceCollision>& out) const {
-    if (!batched_np()) {
+    if (!batched()) {
       kernel_vf(v, f, c, out);
       return;
     }
     if (!links.empty() && vf_linked(v, f)) return;
-    b.vf_ids[b.vf.size] = {v, f};
-    b.vf.push({v0[v].data(), v0[t[0]].data(), v0[t[1]].data(), v0[t[2]].data(), v1[v].data(),
-               v1[t[0]].data(), v1[t[1]].data(), v1[t[2]].data()});
-    if (b.vf.full()) flush_vf(b, c, out);
+    if (b.push_vf({v, f}, vf_points(v, *this, t))) flush_vf(b, c, out);
   }
   /// kernel_ee deferred to a batch (as queue_vf).
   void queue_ee(int ea, int eb, FeatureBatch& b, FeatureCounters& c,
@@ -262,21 +283,62 @@ struct FeatureContext {
   /// The same, given the edges' vertices `a` and `d` (topo->edges()[ea], [eb]).
   void queue_ee(int ea, int eb, const Edge& a, const Edge& d, FeatureBatch& b, FeatureCounters& c,
                 std::vector<EdgeEdgeCollision>& out) const {
-    if (!batched_np()) {
+    if (!batched()) {
       kernel_ee(ea, eb, c, out);
       return;
     }
     if (!links.empty() && ee_linked(ea, eb)) return;
-    b.ee_ids[b.ee.size] = {ea, eb};
-    b.ee.push({v0[a[0]].data(), v0[a[1]].data(), v0[d[0]].data(), v0[d[1]].data(), v1[a[0]].data(),
-               v1[a[1]].data(), v1[d[0]].data(), v1[d[1]].data()});
-    if (b.ee.full()) flush_ee(b, c, out);
+    if (b.push_ee({ea, eb}, ee_points(a, *this, d))) flush_ee(b, c, out);
+  }
+  /// The points of vertex v of this context's mesh against face t of side `sf`'s (this one, or
+  /// the other mesh's in a two-mesh detection), in the batches' order.
+  [[nodiscard]] std::array<const double*, 8> vf_points(int v, const FeatureContext& sf,
+                                                       const Face& t) const {
+    return {v0[v].data(), sf.v0[t[0]].data(), sf.v0[t[1]].data(), sf.v0[t[2]].data(),
+            v1[v].data(), sf.v1[t[0]].data(), sf.v1[t[1]].data(), sf.v1[t[2]].data()};
+  }
+  /// The points of edge a of this context's mesh against edge d of side `sd`'s.
+  [[nodiscard]] std::array<const double*, 8> ee_points(const Edge& a, const FeatureContext& sd,
+                                                       const Edge& d) const {
+    return {v0[a[0]].data(), v0[a[1]].data(), sd.v0[d[0]].data(), sd.v0[d[1]].data(),
+            v1[a[0]].data(), v1[a[1]].data(), sd.v1[d[0]].data(), sd.v1[d[1]].data()};
   }
   /// Tests the pairs still queued in `b`.
   void flush(FeatureBatch& b, FeatureCounters& c, std::vector<VertexFaceCollision>& vf,
              std::vector<EdgeEdgeCollision>& ee) const {
     flush_vf(b, c, vf);
     flush_ee(b, c, ee);
+  }
+
+  /// Tests the queries queued in `q` (b.vf or b.ee, of kind `kind`; b's other arrays serve as
+  /// scratch) as ccd_hit tests them, and empties it: the batch filters, then the kernel on what
+  /// they keep. Counts each query in `tests` and a filter's cull in `culled`; calls hit(i, toi)
+  /// for each query i that collides. The same verdicts, counts and times of impact as ccd_hit
+  /// one query at a time.
+  template <class Hit>
+  void flush_queries(ccd_detail::Kind kind, ccd_detail::NpBatch& q, FeatureBatch& b,
+                     std::uint64_t& tests, std::uint64_t& culled, Hit&& hit) const {
+    if (q.size == 0) return;
+    filter_batch(kind, q, b);
+    const bool settle = settles();
+    for (int i = 0; i < q.size; ++i) {
+      ++tests;
+      if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
+        culled += np_filter ? 1 : 0;
+        continue;
+      }
+      if (settle && b.settled[i] != ccd_detail::FastSettled::Run) {  // the kernel's own answer
+        if (b.settled[i] == ccd_detail::FastSettled::Hit) hit(i, b.toi[i]);
+        continue;
+      }
+      double toi = 1.0;
+      const bool kept = b.verdict[i] == ccd_detail::NpVerdict::Kept;
+      const bool collides = kind == ccd_detail::Kind::VertexFace
+                                ? ccd_test(query_at<VertexFaceQuery>(q, i), culled, toi, kept)
+                                : ccd_test(query_at<EdgeEdgeQuery>(q, i), culled, toi, kept);
+      if (collides) hit(i, toi);
+    }
+    q.size = 0;
   }
 
   /// One feature query of any mesh or meshes through this context's filters and kernel: the NP
@@ -312,94 +374,74 @@ struct FeatureContext {
   [[nodiscard]] bool batched_np() const {
     return ccd.thickness == 0 && (np_filter || ccd.fast_path);
   }
+  /// Whether queue_vf / queue_ee defer pairs to a batch: where a query's first test has a
+  /// vectorised form, the cubic NP filter at zero thickness (batched_np) or the distance filter
+  /// at a thickness (distance_at_thickness). In a simulator's contact stage (a thickness, pairs
+  /// mostly resting at about that distance) the distance filter culls nearly all of them.
+  [[nodiscard]] bool batched() const { return batched_np() || distance_at_thickness(); }
 
  private:
-  // ccd_hit without counting the test. `np_kept`: unscaled_np_filter has kept q already (then
-  // np_filter_culls is false, and the kernel need not run that filter again).
+  // ccd_hit without counting the test. `kept`: the batch's filters have kept q already (at zero
+  // thickness unscaled_np_filter's verdict is Kept, then np_filter_culls is false and the kernel
+  // need not run that filter again; at a thickness the distance filter has not culled it).
   template <class Query>
-  bool ccd_test(const Query& q, std::uint64_t& culled, double& toi, bool np_kept = false) const {
-    // At zero thickness the distance filter tests what the NP filter keeps, as in the batches
-    // (whose kept pairs arrive here np_kept, already through it).
-    if ((separate_np() && !np_kept && np_filter_culls(q)) ||
-        (distance_at_thickness() && distance_filter_culls(q, ccd.thickness, distance_depth)) ||
-        (distance_at_zero() && !np_kept && !np_filter_culls(q) &&
-         distance_filter_culls(q, 0.0, kZeroThicknessDepth))) {
+  bool ccd_test(const Query& q, std::uint64_t& culled, double& toi, bool kept = false) const {
+    // At zero thickness the distance filter tests what the NP filter keeps, as in the batches.
+    if (!kept &&
+        ((separate_np() && np_filter_culls(q)) ||
+         (distance_at_thickness() && distance_filter_culls(q, ccd.thickness, distance_depth)) ||
+         (distance_at_zero() && !np_filter_culls(q) &&
+          distance_filter_culls(q, 0.0, kZeroThicknessDepth)))) {
       ++culled;
       return false;
     }
-    const CcdResult r = np_kept ? ccd_kernel_np_kept(q, ccd) : ccd_kernel(q, ccd);
+    const CcdResult r =
+        kept && ccd.thickness == 0 ? ccd_kernel_np_kept(q, ccd) : ccd_kernel(q, ccd);
     culled += counted_np(r);
     if (r.hit) toi = r.toi;
     return r.hit;
   }
 
-  // The batch's filters in ccd_test's order: the NP filter, the distance filter on what it keeps
+  // Whether the batches settle queries with the zero-thickness kernel's own search.
+  [[nodiscard]] bool settles() const { return ccd.fast_path && ccd.thickness == 0; }
+
+  // The batch's filters in ccd_test's order. At a thickness the distance filter alone (every
+  // query starts Kept). At zero thickness the NP filter, the distance filter on what it keeps
   // (distance_at_zero), and with the fast path the kernel's own search down to kSettleLevel.
   void filter_batch(ccd_detail::Kind kind, const ccd_detail::NpBatch& q, FeatureBatch& b) const {
+    if (distance_at_thickness()) {
+      std::fill_n(b.verdict.begin(), q.size, ccd_detail::NpVerdict::Kept);
+      ccd_detail::distance_filter_batch(kind, q, ccd.thickness, distance_depth, b.verdict.data());
+      return;
+    }
     ccd_detail::np_filter_batch(kind, q, b.verdict.data());
     if (distance_at_zero()) {
       ccd_detail::distance_filter_batch(kind, q, 0.0, kZeroThicknessDepth, b.verdict.data());
     }
-    if (ccd.fast_path) {
+    if (settles()) {
       ccd_detail::fast_path_settle(kind, q, b.verdict.data(), ccd.toi_tolerance, b.settled.data(),
                                    b.toi.data());
     }
   }
 
   // A culled pair (by the NP filter, or by the distance filter after it) counts as culled by the
-  // NP filter where ccd_hit counts it so: always for the separate filter, with the fast path
-  // where the NP filter is on (counted_np). With the fast path (batched_np() implies zero
+  // NP filter where ccd_hit counts it so: always for the separate filter and at a thickness,
+  // with the fast path where the NP filter is on (counted_np). With the fast path (zero
   // thickness), the kept pairs that fast_path_settle settles are the kernel's misses on path
   // FastPath (nothing to count or report) and its certified hits (reported with the kernel's
   // time of impact).
   void flush_vf(FeatureBatch& b, FeatureCounters& c, std::vector<VertexFaceCollision>& out) const {
-    if (b.vf.size == 0) return;
-    filter_batch(ccd_detail::Kind::VertexFace, b.vf, b);
-    const bool settle = ccd.fast_path;
-    for (int i = 0; i < b.vf.size; ++i) {
-      ++c.vf_tests;
-      if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
-        c.vf_np += np_filter ? 1 : 0;
-        continue;
-      }
-      const auto [v, f] = b.vf_ids[i];
-      const Face& t = topo->faces()[f];
-      if (settle && b.settled[i] != ccd_detail::FastSettled::Run) {  // the kernel's own answer
-        if (b.settled[i] == ccd_detail::FastSettled::Hit) out.push_back({v, f, t, b.toi[i]});
-        continue;
-      }
-      const VertexFaceQuery q{v0[v], v0[t[0]], v0[t[1]], v0[t[2]],
-                              v1[v], v1[t[0]], v1[t[1]], v1[t[2]]};
-      double toi = 1.0;
-      const bool kept = b.verdict[i] == ccd_detail::NpVerdict::Kept;
-      if (ccd_test(q, c.vf_np, toi, kept)) out.push_back({v, f, t, toi});
-    }
-    b.vf.size = 0;
+    flush_queries(ccd_detail::Kind::VertexFace, b.vf, b, c.vf_tests, c.vf_np,
+                  [&](int i, double toi) {
+                    const auto [v, f] = b.vf_ids[i];
+                    out.push_back({v, f, topo->faces()[f], toi});
+                  });
   }
   void flush_ee(FeatureBatch& b, FeatureCounters& c, std::vector<EdgeEdgeCollision>& out) const {
-    if (b.ee.size == 0) return;
-    filter_batch(ccd_detail::Kind::EdgeEdge, b.ee, b);
-    const bool settle = ccd.fast_path;
-    for (int i = 0; i < b.ee.size; ++i) {
-      ++c.ee_tests;
-      if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
-        c.ee_np += np_filter ? 1 : 0;
-        continue;
-      }
+    flush_queries(ccd_detail::Kind::EdgeEdge, b.ee, b, c.ee_tests, c.ee_np, [&](int i, double toi) {
       const auto [ea, eb] = b.ee_ids[i];
-      const Edge& a = topo->edges()[ea];
-      const Edge& d = topo->edges()[eb];
-      if (settle && b.settled[i] != ccd_detail::FastSettled::Run) {  // the kernel's own answer
-        if (b.settled[i] == ccd_detail::FastSettled::Hit) out.push_back({ea, eb, a, d, b.toi[i]});
-        continue;
-      }
-      const EdgeEdgeQuery q{v0[a[0]], v0[a[1]], v0[d[0]], v0[d[1]],
-                            v1[a[0]], v1[a[1]], v1[d[0]], v1[d[1]]};
-      double toi = 1.0;
-      const bool kept = b.verdict[i] == ccd_detail::NpVerdict::Kept;
-      if (ccd_test(q, c.ee_np, toi, kept)) out.push_back({ea, eb, a, d, toi});
-    }
-    b.ee.size = 0;
+      out.push_back({ea, eb, topo->edges()[ea], topo->edges()[eb], toi});
+    });
   }
 
   // With the fast path on, the kernel starts with the same NP filter (one cubic, computed once);

@@ -133,6 +133,9 @@ void face_pair(const detail::FeatureContext& ca, const detail::FeatureContext& c
 struct Buffer {
   detail::FeatureCounters c;
   detail::FacesApartBatch faces;  // triangle pairs, distance-filtered a batch at a time
+  // Feature pairs waiting for the batch filters: A's vertices against B's faces and the edge
+  // pairs in `queued`, B's vertices against A's faces in `queued_ba` (its vf part).
+  detail::FeatureBatch queued, queued_ba;
   std::vector<VertexFaceCollision> ab, ba;
   std::vector<EdgeEdgeCollision> ee;
 };
@@ -285,6 +288,33 @@ struct PairDetector::Impl {
     tbb::enumerable_thread_specific<Buffer> locals;
     const Scope scope{*this};
     const bool batched = ca.faces_apart_filter();
+    // Both contexts have the same settings; ca's filters and kernels test every feature pair.
+    const bool queued = ca.batched();
+    const auto& faces_a = a.topo.faces();
+    const auto& faces_b = b.topo.faces();
+    const auto& edges_a = a.topo.edges();
+    const auto& edges_b = b.topo.edges();
+    const auto flush_ab = [&](Buffer& out) {
+      ca.flush_queries(ccd_detail::Kind::VertexFace, out.queued.vf, out.queued, out.c.vf_tests,
+                       out.c.vf_np, [&](int i, double toi) {
+                         const auto [v, f] = out.queued.vf_ids[i];
+                         out.ab.push_back({v, f, faces_b[f], toi});
+                       });
+    };
+    const auto flush_ba = [&](Buffer& out) {
+      ca.flush_queries(ccd_detail::Kind::VertexFace, out.queued_ba.vf, out.queued_ba,
+                       out.c.vf_tests, out.c.vf_np, [&](int i, double toi) {
+                         const auto [u, f] = out.queued_ba.vf_ids[i];
+                         out.ba.push_back({u, f, faces_a[f], toi});
+                       });
+    };
+    const auto flush_ee = [&](Buffer& out) {
+      ca.flush_queries(ccd_detail::Kind::EdgeEdge, out.queued.ee, out.queued, out.c.ee_tests,
+                       out.c.ee_np, [&](int i, double toi) {
+                         const auto [ea, eb] = out.queued.ee_ids[i];
+                         out.ee.push_back({ea, eb, edges_a[ea], edges_b[eb], toi});
+                       });
+    };
     constexpr std::size_t kBatch = detail::FacesApartBatch::kCapacity;
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, pairs.size(), kBatch),
@@ -308,23 +338,44 @@ struct PairDetector::Impl {
               ++out.c.faces_apart;
               continue;
             }
+            if (queued) {
+              face_pair(
+                  ca, cb, fa, fb, scope,
+                  [&](int v, int f) {
+                    if (out.queued.push_vf({v, f}, ca.vf_points(v, cb, faces_b[f]))) flush_ab(out);
+                  },
+                  [&](int u, int f) {
+                    if (out.queued_ba.push_vf({u, f}, cb.vf_points(u, ca, faces_a[f])))
+                      flush_ba(out);
+                  },
+                  [&](int ea, int eb) {
+                    if (out.queued.push_ee({ea, eb}, ca.ee_points(edges_a[ea], cb, edges_b[eb])))
+                      flush_ee(out);
+                  });
+              continue;
+            }
             double toi = 1.0;
             face_pair(
                 ca, cb, fa, fb, scope,
                 [&](int v, int f) {
                   if (vf_hit(ca, ca, v, cb, f, out.c, toi))
-                    out.ab.push_back({v, f, b.topo.faces()[f], toi});
+                    out.ab.push_back({v, f, faces_b[f], toi});
                 },
                 [&](int u, int f) {
                   if (vf_hit(ca, cb, u, ca, f, out.c, toi))
-                    out.ba.push_back({u, f, a.topo.faces()[f], toi});
+                    out.ba.push_back({u, f, faces_a[f], toi});
                 },
                 [&](int ea, int eb) {
                   if (ee_hit(ca, ea, cb, eb, out.c, toi))
-                    out.ee.push_back({ea, eb, a.topo.edges()[ea], b.topo.edges()[eb], toi});
+                    out.ee.push_back({ea, eb, edges_a[ea], edges_b[eb], toi});
                 });
           }
         });
+    for (auto& out : locals) {  // at most one partial batch of each kind per thread
+      flush_ab(out);
+      flush_ba(out);
+      flush_ee(out);
+    }
     PairDetectResult res = collect(locals);
     res.stats.box_tests = st.box_tests;
     res.stats.front_pairs = st.front_pairs;
