@@ -259,8 +259,8 @@ struct FeatureContext {
   }
 
   /// kernel_vf deferred to a batch: the pairs the batched filters cull are counted as kernel_vf
-  /// counts them, the others go through kernel_vf's path. Without a vectorised filter in the
-  /// settings (batched()), kernel_vf at once. `flush` tests what is left.
+  /// counts them, the others go through kernel_vf's path (all of them without a vectorised
+  /// filter in the settings, batched()). `flush` tests what is left.
   void queue_vf(int v, int f, FeatureBatch& b, FeatureCounters& c,
                 std::vector<VertexFaceCollision>& out) const {
     queue_vf(v, f, topo->faces()[f], b, c, out);
@@ -268,10 +268,6 @@ struct FeatureContext {
   /// The same, given f's corners `t` (topo->faces()[f]).
   void queue_vf(int v, int f, const Face& t, FeatureBatch& b, FeatureCounters& c,
                 std::vector<VertexFaceCollision>& out) const {
-    if (!batched()) {
-      kernel_vf(v, f, c, out);
-      return;
-    }
     if (!links.empty() && vf_linked(v, f)) return;
     if (b.push_vf({v, f}, vf_points(v, *this, t))) flush_vf(b, c, out);
   }
@@ -283,10 +279,6 @@ struct FeatureContext {
   /// The same, given the edges' vertices `a` and `d` (topo->edges()[ea], [eb]).
   void queue_ee(int ea, int eb, const Edge& a, const Edge& d, FeatureBatch& b, FeatureCounters& c,
                 std::vector<EdgeEdgeCollision>& out) const {
-    if (!batched()) {
-      kernel_ee(ea, eb, c, out);
-      return;
-    }
     if (!links.empty() && ee_linked(ea, eb)) return;
     if (b.push_ee({ea, eb}, ee_points(a, *this, d))) flush_ee(b, c, out);
   }
@@ -312,15 +304,20 @@ struct FeatureContext {
 
   /// Tests the queries queued in `q` (b.vf or b.ee, of kind `kind`; b's other arrays serve as
   /// scratch) as ccd_hit tests them, and empties it: the batch filters, then the kernel on what
-  /// they keep. Counts each query in `tests` and a filter's cull in `culled`; calls hit(i, toi)
-  /// for each query i that collides. The same verdicts, counts and times of impact as ccd_hit
-  /// one query at a time.
+  /// they keep (without a vectorised filter in the settings, batched(), ccd_hit's own path one
+  /// query at a time). Counts each query in `tests` and a filter's cull in `culled`; calls
+  /// hit(i, toi) for each query i that collides. The same verdicts, counts and times of impact
+  /// as ccd_hit one query at a time.
   template <class Hit>
   void flush_queries(ccd_detail::Kind kind, ccd_detail::NpBatch& q, FeatureBatch& b,
                      std::uint64_t& tests, std::uint64_t& culled, Hit&& hit) const {
     if (q.size == 0) return;
-    filter_batch(kind, q, b);
-    const bool settle = settles();
+    if (batched()) {
+      filter_batch(kind, q, b);
+    } else {
+      std::fill_n(b.verdict.begin(), q.size, ccd_detail::NpVerdict::Undecided);
+    }
+    const bool settle = batched() && settles();
     for (int i = 0; i < q.size; ++i) {
       ++tests;
       if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {

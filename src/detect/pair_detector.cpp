@@ -289,7 +289,6 @@ struct PairDetector::Impl {
     const Scope scope{*this};
     const bool batched = ca.faces_apart_filter();
     // Both contexts have the same settings; ca's filters and kernels test every feature pair.
-    const bool queued = ca.batched();
     const auto& faces_a = a.topo.faces();
     const auto& faces_b = b.topo.faces();
     const auto& edges_a = a.topo.edges();
@@ -338,36 +337,17 @@ struct PairDetector::Impl {
               ++out.c.faces_apart;
               continue;
             }
-            if (queued) {
-              face_pair(
-                  ca, cb, fa, fb, scope,
-                  [&](int v, int f) {
-                    if (out.queued.push_vf({v, f}, ca.vf_points(v, cb, faces_b[f]))) flush_ab(out);
-                  },
-                  [&](int u, int f) {
-                    if (out.queued_ba.push_vf({u, f}, cb.vf_points(u, ca, faces_a[f])))
-                      flush_ba(out);
-                  },
-                  [&](int ea, int eb) {
-                    if (out.queued.push_ee({ea, eb}, ca.ee_points(edges_a[ea], cb, edges_b[eb])))
-                      flush_ee(out);
-                  });
-              continue;
-            }
-            double toi = 1.0;
             face_pair(
                 ca, cb, fa, fb, scope,
                 [&](int v, int f) {
-                  if (vf_hit(ca, ca, v, cb, f, out.c, toi))
-                    out.ab.push_back({v, f, faces_b[f], toi});
+                  if (out.queued.push_vf({v, f}, ca.vf_points(v, cb, faces_b[f]))) flush_ab(out);
                 },
                 [&](int u, int f) {
-                  if (vf_hit(ca, cb, u, ca, f, out.c, toi))
-                    out.ba.push_back({u, f, faces_a[f], toi});
+                  if (out.queued_ba.push_vf({u, f}, cb.vf_points(u, ca, faces_a[f]))) flush_ba(out);
                 },
                 [&](int ea, int eb) {
-                  if (ee_hit(ca, ea, cb, eb, out.c, toi))
-                    out.ee.push_back({ea, eb, edges_a[ea], edges_b[eb], toi});
+                  if (out.queued.push_ee({ea, eb}, ca.ee_points(edges_a[ea], cb, edges_b[eb])))
+                    flush_ee(out);
                 });
           }
         });

@@ -69,6 +69,29 @@ TEST(PairDetector, ThickStepsEqualBruteForceWithFilterDepthAndToiTolerance) {
   }
 }
 
+// Every filter setting, at zero thickness and with one: the batched stages (NP filter, distance
+// filter, fast path) where the settings have them, the scalar path one query at a time where they
+// have none; brute force runs the scalar path on every pair.
+TEST(PairDetector, EveryFilterSettingEqualsBruteForce) {
+  const Scene s;
+  for (double thickness : {0.0, 0.004}) {
+    for (int bits = 0; bits < 8; ++bits) {
+      DetectOptions o = simulator_options(thickness, 4);
+      o.np_filter = (bits & 1) != 0;
+      o.fast_path = (bits & 2) != 0;
+      o.distance_filter = (bits & 4) != 0;
+      SCOPED_TRACE(::testing::Message()
+                   << "thickness " << thickness << " np " << o.np_filter << " fast " << o.fast_path
+                   << " distance " << o.distance_filter);
+      const PairDetectResult ref =
+          brute_force_detect_pair(s.ta, s.a.v0, s.a.v1, s.tb, s.b.v0, s.b.v1, o);
+      EXPECT_GT(ref.vf_a_on_b.size() + ref.vf_b_on_a.size() + ref.ee.size(), 0u);
+      PairDetector det(s.a.faces, s.a.nv(), s.a.v0, s.b.faces, s.b.nv(), s.b.v0, o);
+      expect_pair_equal(det.detect(s.a.v0, s.a.v1, s.b.v0, s.b.v1), ref);
+    }
+  }
+}
+
 TEST(PairDetector, ActiveVerticesKeepExactlyThePairsWithAnActiveVertex) {
   const Scene s;
   const DetectOptions o = simulator_options(0.004, 6);
