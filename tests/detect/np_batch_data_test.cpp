@@ -353,7 +353,9 @@ TEST(NpBatchData, QueuedPairsGiveTheScalarResultsAtAThickness) {
       EXPECT_GT(n.vf_np, n.vf_tests / 2);
       EXPECT_GT(n.ee_np, n.ee_tests / 2);
       EXPECT_LT(n.vf_np + n.ee_np, n.vf_tests + n.ee_tests);
-      if (thickness == 1e-3) EXPECT_GT(t.collisions, 0u);
+      if (thickness == 1e-3) {
+        EXPECT_GT(t.collisions, 0u);
+      }
     }
   }
 }
