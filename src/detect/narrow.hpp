@@ -312,12 +312,8 @@ struct FeatureContext {
   void flush_queries(ccd_detail::Kind kind, ccd_detail::NpBatch& q, FeatureBatch& b,
                      std::uint64_t& tests, std::uint64_t& culled, Hit&& hit) const {
     if (q.size == 0) return;
-    if (batched()) {
-      filter_batch(kind, q, b);
-    } else {
-      std::fill_n(b.verdict.begin(), q.size, ccd_detail::NpVerdict::Undecided);
-    }
-    const bool settle = batched() && settles();
+    filter_batch(kind, q, b);
+    const bool settle = settles();
     for (int i = 0; i < q.size; ++i) {
       ++tests;
       if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
@@ -402,10 +398,15 @@ struct FeatureContext {
   // Whether the batches settle queries with the zero-thickness kernel's own search.
   [[nodiscard]] bool settles() const { return ccd.fast_path && ccd.thickness == 0; }
 
-  // The batch's filters in ccd_test's order. At a thickness the distance filter alone (every
-  // query starts Kept). At zero thickness the NP filter, the distance filter on what it keeps
+  // The batch's filters in ccd_test's order. Without a vectorised filter none (every verdict
+  // Undecided: ccd_test decides). At a thickness the distance filter alone (every query starts
+  // Kept). At zero thickness the NP filter, the distance filter on what it keeps
   // (distance_at_zero), and with the fast path the kernel's own search down to kSettleLevel.
   void filter_batch(ccd_detail::Kind kind, const ccd_detail::NpBatch& q, FeatureBatch& b) const {
+    if (!batched()) {
+      std::fill_n(b.verdict.begin(), q.size, ccd_detail::NpVerdict::Undecided);
+      return;
+    }
     if (distance_at_thickness()) {
       std::fill_n(b.verdict.begin(), q.size, ccd_detail::NpVerdict::Kept);
       ccd_detail::distance_filter_batch(kind, q, ccd.thickness, distance_depth, b.verdict.data());

@@ -293,20 +293,17 @@ struct PairDetector::Impl {
     const auto& faces_b = b.topo.faces();
     const auto& edges_a = a.topo.edges();
     const auto& edges_b = b.topo.edges();
-    const auto flush_ab = [&](Buffer& out) {
-      ca.flush_queries(ccd_detail::Kind::VertexFace, out.queued.vf, out.queued, out.c.vf_tests,
-                       out.c.vf_np, [&](int i, double toi) {
-                         const auto [v, f] = out.queued.vf_ids[i];
-                         out.ab.push_back({v, f, faces_b[f], toi});
+    // The VF pairs queued in q (vertices of one mesh against `faces` of the other) into `hits`.
+    const auto flush_vf = [&](Buffer& out, detail::FeatureBatch& q, const std::vector<Face>& faces,
+                              std::vector<VertexFaceCollision>& hits) {
+      ca.flush_queries(ccd_detail::Kind::VertexFace, q.vf, q, out.c.vf_tests, out.c.vf_np,
+                       [&](int i, double toi) {
+                         const auto [v, f] = q.vf_ids[i];
+                         hits.push_back({v, f, faces[f], toi});
                        });
     };
-    const auto flush_ba = [&](Buffer& out) {
-      ca.flush_queries(ccd_detail::Kind::VertexFace, out.queued_ba.vf, out.queued_ba,
-                       out.c.vf_tests, out.c.vf_np, [&](int i, double toi) {
-                         const auto [u, f] = out.queued_ba.vf_ids[i];
-                         out.ba.push_back({u, f, faces_a[f], toi});
-                       });
-    };
+    const auto flush_ab = [&](Buffer& out) { flush_vf(out, out.queued, faces_b, out.ab); };
+    const auto flush_ba = [&](Buffer& out) { flush_vf(out, out.queued_ba, faces_a, out.ba); };
     const auto flush_ee = [&](Buffer& out) {
       ca.flush_queries(ccd_detail::Kind::EdgeEdge, out.queued.ee, out.queued, out.c.ee_tests,
                        out.c.ee_np, [&](int i, double toi) {
