@@ -50,8 +50,9 @@ STAGES = [
     ("feature distance filter (vectorised)", 3, [r"clothcd::ccd_detail::distance_filter_batch\("]),
     ("fast-path settle (vectorised)", 3, [r"clothcd::ccd_detail::fast_path_settle\("]),
     ("scalar kernels (the pairs left undecided)", 3,
-     [r"clothcd::ccd_detail::vertex_face_ccd_np_kept\(", r"clothcd::ccd_detail::edge_edge_ccd_np_kept\(",
-      r"^clothcd::vertex_face_ccd\(", r"^clothcd::edge_edge_ccd\("]),
+     [r"clothcd::ccd_detail::vertex_face_ccd_np_kept\(",
+      r"clothcd::ccd_detail::edge_edge_ccd_np_kept\(", r"^clothcd::vertex_face_ccd\(",
+      r"^clothcd::edge_edge_ccd\("]),
 ]
 # The narrow phase's remainder: R-triangle ownership, feature boxes, gathering coordinates into
 # the batches, orphans.
@@ -111,14 +112,12 @@ def table(name, rows, stats):
     out = [f"### {name}", "",
            f"{pairs:,} triangle pairs, {tests:,} feature tests, "
            f"{stats['vf_collisions'] + stats['ee_collisions']:,} collisions.", "",
-           "| stage | instructions (M) | share of detection | per triangle pair | per feature test |",
+           "| stage | instructions (M) | share of detection | per triangle pair "
+           "| per feature test |",
            "|---|---:|---:|---:|---:|"]
-    order = [r for r in rows if r[0] != REST]
-    order.insert(len(order), next(r for r in rows if r[0] == REST))
-    for label, depth, n in order:
-        share = f"{100 * n / detection:.1f}%" if depth >= 1 and label not in (
-            "reading the frames", "building the detector (topology, tree, orphans, ownership)") \
-            else ""
+    for label, depth, n in rows:
+        # Reading and building come before the detection, which the deeper rows divide.
+        share = f"{100 * n / detection:.1f}%" if label == "detection" or depth >= 2 else ""
         indent = "&nbsp;&nbsp;" * max(0, depth - 1)
         out.append(f"| {indent}{label} | {n / 1e6:,.0f} | {share} | "
                    f"{n / max(pairs, 1):,.0f} | {n / max(tests, 1):,.0f} |")
@@ -154,7 +153,8 @@ def main():
         for name, args in detect_speed.cases(detect_speed.data_dir(), a.frames):
             rows, stats = profile(binary, args, Path(tmp))
             out += table(name, rows, stats) + [""]
-            print(f"{name}: detection {rows[3][2] / 1e6:,.0f} M instructions", file=sys.stderr)
+            detection = next(n for label, _, n in rows if label == "detection")
+            print(f"{name}: detection {detection / 1e6:,.0f} M instructions", file=sys.stderr)
     Path(a.out).write_text("\n".join(out))
 
 
