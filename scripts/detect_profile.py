@@ -78,12 +78,16 @@ def inclusive_counts(callgrind_out):
 
 
 def stage_count(counts, patterns):
+    """The stage's count, or None where no function of the profile matches (a renamed function
+    would otherwise read as a stage that costs nothing)."""
+    found = False
     total = 0
     for p in patterns:
         rx = re.compile(p)
-        found = [n for name, n in counts if rx.search(name)]
-        total += max(found, default=0)
-    return total
+        matches = [n for name, n in counts if rx.search(name)]
+        found = found or bool(matches)
+        total += max(matches, default=0)
+    return total if found else None
 
 
 def profile(binary, args, tmp):
@@ -95,11 +99,14 @@ def profile(binary, args, tmp):
     subprocess.run(cmd, check=True, capture_output=True, text=True)
     counts = inclusive_counts(out)
     stats = json.loads(js.read_text())["stats"]
-    rows = [(label, depth, stage_count(counts, pats)) for label, depth, pats in STAGES]
+    rows = []
+    for label, depth, pats in STAGES:
+        n = stage_count(counts, pats)
+        if n is None:
+            sys.exit(f"detect_profile.py: no function of the profile matches the stage '{label}' "
+                     f"({', '.join(pats)}): renamed, inlined, or a binary without symbols?")
+        rows.append((label, depth, n))
     by = {label: n for label, _, n in rows}
-    if by["detection"] == 0 or by["narrow phase"] == 0:
-        sys.exit("detect_profile.py: the detector's functions are missing from the profile "
-                 "(a binary without symbols?)")
     inner = sum(n for label, depth, n in rows if depth == 3)
     rows.append((REST, 3, by["narrow phase"] - inner))
     return rows, stats
