@@ -27,8 +27,10 @@ struct ContactHandler::Impl {
   detail::ProximityContacts proximity;
   detail::CcdHits ccd;
   detail::ImpactProjection projection;
-  // The parts outside CcdHits (which keeps its own in ccd.times).
+  // What the stages returned since ContactHandler last took it.
   CollisionPartTimes times;
+  SelfCcdFigures self_ccd;
+  SelfProximityFigures self_proximity;
 
   Impl(const ClothModel& m, const ContactOptions& o)
       : opt(o),
@@ -48,9 +50,9 @@ struct ContactHandler::Impl {
     {
       PartClock clock(times.setup_s);
       geometry.start(ctx);
-      ccd.excluded = 0;
-      // The crossing count and the escapes need the body's topology, which its detector holds.
-      if (body) detectors.start_body(ctx, geometry);
+      // Before the crossing count too: it and the escapes need the body's topology, which the
+      // body detector holds.
+      detectors.start(ctx, geometry, opt.self, body);
     }
     {
       PartClock clock(times.crossings_s);
@@ -58,13 +60,20 @@ struct ContactHandler::Impl {
       escapes.find(geometry, crossings.body_pairs(), opt.thickness, opt.untangle_step);
     }
     PartClock clock(times.proximity_s);
-    proximity.find(detectors, escapes, opt.self, body);
+    self_proximity += proximity.find(detectors, escapes, opt.self, body);
   }
 
+  // One CCD pass; its figures go to `st` (hits left out), self_ccd and `part_times`.
   [[nodiscard]] std::vector<detail::Contact> hits(const SubstepContext& ctx,
                                                   std::span<const Vec3> v,
-                                                  const std::vector<int>* active) {
-    return ccd.find(v, active, opt.self, has_body(ctx));
+                                                  const std::vector<int>* active, double sep_scale,
+                                                  CollisionStats& st,
+                                                  CollisionPartTimes& part_times) {
+    detail::CcdPass pass = ccd.find(v, active, sep_scale, opt.self, has_body(ctx));
+    st.excluded += pass.excluded;
+    self_ccd += pass.self_ccd;
+    part_times += pass.times;
+    return std::move(pass.contacts);
   }
 
   CollisionStats respond(const SubstepContext& ctx, std::span<Vec3> v) {
@@ -85,7 +94,7 @@ struct ContactHandler::Impl {
     bool clean = false;
     for (int pass = 0; pass < opt.ccd_iterations; ++pass) {
       const std::vector<detail::Contact> hs =
-          hits(ctx, v, pass == 0 || opt.full_passes ? nullptr : &active);
+          hits(ctx, v, pass == 0 || opt.full_passes ? nullptr : &active, 1.0, st, times);
       ++st.ccd_passes;
       st.ccd_hits += static_cast<long long>(hs.size());
       if (hs.empty()) {
@@ -99,22 +108,22 @@ struct ContactHandler::Impl {
     }
     // 3. Impact zones for the hits the passes left.
     if (!clean) {
-      const detail::ZoneHits zone_hits =
-          [&](std::span<const Vec3> vz, const std::vector<int>* act) { return hits(ctx, vz, act); };
-      // The zones' own time: less the CCD calls they make, which ccd.times counts.
-      const double before = ccd.times.total();
+      // The zones' own time is theirs less that of the CCD passes they run.
+      CollisionPartTimes zone_ccd;
+      const detail::ZoneHits zone_hits = [&](std::span<const Vec3> vz, const std::vector<int>* act,
+                                             double sep_scale) {
+        return hits(ctx, vz, act, sep_scale, st, zone_ccd);
+      };
       double all = 0.0;
       {
         PartClock clock(all);
-        detail::resolve_zones(geometry, opt, zone_hits, ccd.sep_scale, v, touched, st);
+        st += detail::resolve_zones(geometry, opt, zone_hits, v, touched);
       }
-      times.zones_s += all - (ccd.times.total() - before);
+      times.zones_s += all - zone_ccd.total();
+      times += zone_ccd;
     }
-    ccd.sep_scale = 1.0;
-    if (opt.self) detectors.self().clear_active_faces();
-    st.excluded = ccd.excluded;
     PartClock clock(times.crossings_s);
-    crossings.end(geometry, v, st.unresolved == 0 && ccd.excluded == 0);
+    crossings.end(geometry, v, st.unresolved == 0 && st.excluded == 0);
     return st;
   }
 };
@@ -166,17 +175,15 @@ CollisionPartTimes& CollisionPartTimes::operator+=(const CollisionPartTimes& o) 
 }
 
 CollisionPartTimes ContactHandler::take_part_times() {
-  CollisionPartTimes t = std::exchange(impl_->times, {});
-  t += std::exchange(impl_->ccd.times, {});
-  return t;
+  return std::exchange(impl_->times, {});
 }
 
 SelfCcdFigures ContactHandler::take_self_ccd_figures() {
-  return std::exchange(impl_->detectors.self_ccd_figures, {});
+  return std::exchange(impl_->self_ccd, {});
 }
 
 SelfProximityFigures ContactHandler::take_self_proximity_figures() {
-  return std::exchange(impl_->detectors.self_proximity_figures, {});
+  return std::exchange(impl_->self_proximity, {});
 }
 
 CollisionStats ContactHandler::respond(const SubstepContext& ctx, std::span<Vec3> v_star) {

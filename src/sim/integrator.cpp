@@ -224,19 +224,13 @@ bool ClothSolver::try_step(ClothState& state, double h, double tolerance, StepSt
   for_each_vertex(n, [&](int i) { v_star[i] = state.v[i] + dv[i]; });
   if (handler_ != nullptr) {
     const auto start = std::chrono::steady_clock::now();
-    const CollisionStats cs = handler_->respond(ctx, v_star);
-    stats.collision.proximity_pairs += cs.proximity_pairs;
-    stats.collision.ccd_hits += cs.ccd_hits;
-    stats.collision.ccd_passes += cs.ccd_passes;
-    stats.collision.zones += cs.zones;
-    stats.collision.zone_rounds += cs.zone_rounds;
-    stats.collision.excluded += cs.excluded;
-    stats.collision.largest_zone = std::max(stats.collision.largest_zone, cs.largest_zone);
-    stats.collision.seconds +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    CollisionStats cs = handler_->respond(ctx, v_star);
+    cs.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // Hits left by a halved attempt are not counted: its shorter substeps retry them.
-    if (!allow_fail && options_.halve_unresolved && cs.unresolved > 0) return false;
-    stats.collision.unresolved += cs.unresolved;
+    const bool halve = !allow_fail && options_.halve_unresolved && cs.unresolved > 0;
+    if (halve) cs.unresolved = 0;
+    stats.collision += cs;
+    if (halve) return false;
   }
   for_each_vertex(n, [&](int i) {
     state.x[i] += h * v_star[i];

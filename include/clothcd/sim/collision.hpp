@@ -5,6 +5,7 @@
 /// b_n), then `respond` on the candidate velocities v* (repulsion, friction, CCD impulses, impact
 /// zones). The handler changes v* only; positions follow as x_{n+1} = x_n + h v*.
 
+#include <algorithm>
 #include <array>
 #include <span>
 #include <vector>
@@ -26,17 +27,30 @@ struct SubstepContext {
   const std::vector<Face>* body_faces = nullptr;
 };
 
-/// Per-substep figures a handler reports; summed per frame.
+/// Per-substep figures a handler reports; summed over a step's substeps and a frame's steps.
 struct CollisionStats {
   long long proximity_pairs = 0;
   long long ccd_hits = 0;
   int ccd_passes = 0;
-  int zones = 0;
+  int zones = 0;  ///< impact zones of a substep's last round; summed over substeps
   int largest_zone = 0;
   int zone_rounds = 0;
   long long unresolved = 0;  ///< CCD hits still present when the zone rounds ran out
   long long excluded = 0;    ///< CCD hits left out: their triangles already crossed at t0
-  double seconds = 0.0;
+  double seconds = 0.0;      ///< wall time of the stage (the integrator measures it)
+  /// Sums every figure but largest_zone, which becomes the larger of the two.
+  CollisionStats& operator+=(const CollisionStats& o) {
+    proximity_pairs += o.proximity_pairs;
+    ccd_hits += o.ccd_hits;
+    ccd_passes += o.ccd_passes;
+    zones += o.zones;
+    largest_zone = std::max(largest_zone, o.largest_zone);
+    zone_rounds += o.zone_rounds;
+    unresolved += o.unresolved;
+    excluded += o.excluded;
+    seconds += o.seconds;
+    return *this;
+  }
 };
 
 /// A cloth vertex resting on the body at the substep start: the dynamics solve moves it along

@@ -132,7 +132,7 @@ struct SelfProximityFigures {
 /// overlap and together make up nearly all of CollisionStats::seconds; what they leave out is
 /// bookkeeping between them. They measure, they change nothing.
 struct CollisionPartTimes {
-  double setup_s = 0.0;      ///< contact geometry and the body detector's start of the substep
+  double setup_s = 0.0;      ///< contact geometry, both detectors' start (creation, self rebuild)
   double crossings_s = 0.0;  ///< crossing pairs at the substep start (and escapes), its end's check
   double proximity_s = 0.0;  ///< proximity queries (self, body) and the contacts built from them
   double response_s = 0.0;   ///< repulsion, friction, escapes and the inelastic projections

@@ -37,21 +37,20 @@ constexpr double kNoReach = std::numeric_limits<double>::infinity();
 
 }  // namespace
 
-std::vector<Contact> CcdHits::find(std::span<const Vec3> v, const std::vector<int>* active,
-                                   bool self, bool body) {
-  // Everything but the detector calls counts as turning hits into contacts.
-  const double detectors = times.ccd_self_s + times.ccd_body_s;
+CcdPass CcdHits::find(std::span<const Vec3> v, const std::vector<int>* active, double sep_scale,
+                      bool self, bool body) {
+  CcdPass out;
   double all = 0.0;
-  std::vector<Contact> out;
   {
     PartClock clock(all);
     std::vector<Vec3> x1(g_.x0.size());
     for (std::size_t i = 0; i < g_.x0.size(); ++i)
       x1[i] = g_.x0[i] + g_.h * v[i];
-    if (self) self_hits(x1, v, active, out);
-    if (body) body_hits(x1, v, active, out);
+    if (self) self_hits(x1, v, active, sep_scale, out);
+    if (body) body_hits(x1, v, active, sep_scale, out);
   }
-  times.ccd_hits_s += all - (times.ccd_self_s + times.ccd_body_s - detectors);
+  // Everything but the detector calls counts as turning hits into contacts.
+  out.times.ccd_hits_s = all - (out.times.ccd_self_s + out.times.ccd_body_s);
   return out;
 }
 
@@ -59,7 +58,7 @@ std::vector<Contact> CcdHits::find(std::span<const Vec3> v, const std::vector<in
 // distance for pairs already closer than twice it (resting contact). A pair inside its own
 // separation at t0 would otherwise be a hit at toi 0 that no non-approaching velocity removes.
 // Negative: the pair touches at t0 and is left to repulsion.
-double CcdHits::separation(double d0) const {
+double CcdHits::separation(double d0, double sep_scale) const {
   if (!(d0 > 0.0)) return -1.0;
   return sep_scale * std::min(opt_.ccd_thickness, 0.5 * d0);
 }
@@ -72,8 +71,8 @@ double CcdHits::separation(double d0) const {
 // roughly (impulses use the geometry at toi), so the retest's kernel, like the detector's, stops
 // refining it at `toi_tolerance` (on the early side).
 template <class Query, class Distance, class Make>
-CcdHits::Hit CcdHits::settle(bool dropped, bool tangled, double toi, const Query& query,
-                             Distance&& d0, Make&& make, double reach) const {
+CcdHits::Hit CcdHits::settle(double sep_scale, bool dropped, bool tangled, double toi,
+                             const Query& query, Distance&& d0, Make&& make, double reach) const {
   Hit r;
   if (dropped) return r;
   if (tangled) {
@@ -82,7 +81,7 @@ CcdHits::Hit CcdHits::settle(bool dropped, bool tangled, double toi, const Query
   }
   const double d = d0();
   if (d > reach) return r;
-  const double s = separation(d);
+  const double s = separation(d, sep_scale);
   if (s < 0) {
     r.fate = Hit::Excluded;
     return r;
@@ -104,27 +103,20 @@ CcdHits::Hit CcdHits::settle(bool dropped, bool tangled, double toi, const Query
 }
 
 void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
-                        const std::vector<int>* active, std::vector<Contact>& out) {
-  SelfDetector& det = det_.self();
+                        const std::vector<int>* active, double sep_scale, CcdPass& out) {
   // The restriction to the active vertices is the detector's work too.
   const DetectResult r = [&] {
-    PartClock clock(times.ccd_self_s);
-    if (active != nullptr) {
-      det.set_active_vertices(*active);
-    } else {
-      det.clear_active_faces();
-    }
-    return det.detect(g_.x0, x1);
+    PartClock clock(out.times.ccd_self_s);
+    return det_.self_ccd(g_, x1, active);
   }();
   if (active == nullptr) {
-    det_.self_pass_done();
-    SelfCcdFigures& f = det_.self_ccd_figures;
-    ++f.calls;
-    f.triangle_pairs += static_cast<long long>(r.stats.triangle_pairs);
-    f.nodes_culled += static_cast<long long>(r.stats.nodes_culled);
-    f.refit_s += r.stats.time_refit;
-    f.traversal_s += r.stats.time_traverse;
-    f.narrow_s += r.stats.time_narrow;
+    SelfCcdFigures& f = out.self_ccd;
+    f.calls = 1;
+    f.triangle_pairs = static_cast<long long>(r.stats.triangle_pairs);
+    f.nodes_culled = static_cast<long long>(r.stats.nodes_culled);
+    f.refit_s = r.stats.time_refit;
+    f.traversal_s = r.stats.time_traverse;
+    f.narrow_s = r.stats.time_narrow;
   }
   // Each hit in parallel; the contacts are then gathered in the detector's sorted order.
   const auto& faces = g_.cloth().faces();
@@ -137,7 +129,8 @@ void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
     const VertexFaceQuery query{x0[q], x0[t[0]], x0[t[1]], x0[t[2]],
                                 x1[q], x1[t[0]], x1[t[1]], x1[t[2]]};
     return settle(
-        g_.vf_linked(q, p.face), crossings_.vf_tangled(g_.cloth(), q, p.face), p.toi, query,
+        sep_scale, g_.vf_linked(q, p.face), crossings_.vf_tangled(g_.cloth(), q, p.face), p.toi,
+        query,
         [&] { return point_triangle_proximity(x0[q], x0[t[0]], x0[t[1]], x0[t[2]]).distance; },
         [&](Contact& c, double toi) { return g_.make_vf(c, q, false, p.face, false, toi, v); },
         kNoReach);
@@ -149,8 +142,8 @@ void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
     const EdgeEdgeQuery query{x0[a[0]], x0[a[1]], x0[b[0]], x0[b[1]],
                               x1[a[0]], x1[a[1]], x1[b[0]], x1[b[1]]};
     return settle(
-        g_.ee_linked(p.edge_a, p.edge_b), crossings_.ee_tangled(g_.cloth(), p.edge_a, p.edge_b),
-        p.toi, query,
+        sep_scale, g_.ee_linked(p.edge_a, p.edge_b),
+        crossings_.ee_tangled(g_.cloth(), p.edge_a, p.edge_b), p.toi, query,
         [&] { return edge_edge_proximity(x0[a[0]], x0[a[1]], x0[b[0]], x0[b[1]]).distance; },
         [&](Contact& c, double toi) {
           return g_.make_ee(c, p.edge_a, false, p.edge_b, false, toi, v);
@@ -164,16 +157,10 @@ void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
 // of the pair's motion (a pair farther apart cannot touch), the measure the separation of a
 // resting pair is taken from.
 void CcdHits::body_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
-                        const std::vector<int>* active, std::vector<Contact>& out) {
-  PairDetector& det = det_.body();
+                        const std::vector<int>* active, double sep_scale, CcdPass& out) {
   const PairDetectResult r = [&] {
-    PartClock clock(times.ccd_body_s);
-    if (active != nullptr) {
-      det.set_active_vertices(*active);
-    } else {
-      det.clear_active();
-    }
-    return det.detect(g_.x0, x1, g_.b0, g_.b1);
+    PartClock clock(out.times.ccd_body_s);
+    return det_.body_ccd(g_, x1, active);
   }();
   const auto& cf = g_.cloth().faces();
   const auto& bf = g_.body().faces();
@@ -191,7 +178,7 @@ void CcdHits::body_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
     const Face& t = bf[p.face];
     const double reach = move_c(i) + std::max({move_b(t[0]), move_b(t[1]), move_b(t[2])}) + sep;
     return settle(
-        escapes_.vertex(i), crossings_.cloth_vertex_body_face(g_, i, p.face), p.toi,
+        sep_scale, escapes_.vertex(i), crossings_.cloth_vertex_body_face(g_, i, p.face), p.toi,
         VertexFaceQuery{x0[i], b0[t[0]], b0[t[1]], b0[t[2]], x1[i], b1[t[0]], b1[t[1]], b1[t[2]]},
         [&] {
           return point_triangle_distance_if_within(x0[i], b0[t[0]], b0[t[1]], b0[t[2]], reach);
@@ -205,7 +192,7 @@ void CcdHits::body_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
     const Face& t = cf[p.face];
     const double reach = move_b(u) + std::max({move_c(t[0]), move_c(t[1]), move_c(t[2])}) + sep;
     return settle(
-        escapes_.face(t), crossings_.body_vertex_cloth_face(g_, u, p.face), p.toi,
+        sep_scale, escapes_.face(t), crossings_.body_vertex_cloth_face(g_, u, p.face), p.toi,
         VertexFaceQuery{b0[u], x0[t[0]], x0[t[1]], x0[t[2]], b1[u], x1[t[0]], x1[t[1]], x1[t[2]]},
         [&] {
           return point_triangle_distance_if_within(b0[u], x0[t[0]], x0[t[1]], x0[t[2]], reach);
@@ -220,7 +207,7 @@ void CcdHits::body_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
     const double reach =
         std::max(move_c(x[0]), move_c(x[1])) + std::max(move_b(y[0]), move_b(y[1])) + sep;
     return settle(
-        escapes_.edge(x), crossings_.cloth_edge_body_edge(g_, p.edge_a, p.edge_b), p.toi,
+        sep_scale, escapes_.edge(x), crossings_.cloth_edge_body_edge(g_, p.edge_a, p.edge_b), p.toi,
         EdgeEdgeQuery{x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], x1[x[0]], x1[x[1]], b1[y[0]],
                       b1[y[1]]},
         [&] { return edge_edge_distance_if_within(x0[x[0]], x0[x[1]], b0[y[0]], b0[y[1]], reach); },
@@ -233,12 +220,11 @@ void CcdHits::body_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
 }
 
 // The kept contacts of settled hits in order; excluded ones are counted.
-void CcdHits::gather(std::initializer_list<const std::vector<Hit>*> lists,
-                     std::vector<Contact>& out) {
+void CcdHits::gather(std::initializer_list<const std::vector<Hit>*> lists, CcdPass& out) {
   for (const auto* l : lists) {
     for (const Hit& hit : *l) {
-      if (hit.fate == Hit::Excluded) ++excluded;
-      if (hit.fate == Hit::Kept) out.push_back(hit.contact);
+      if (hit.fate == Hit::Excluded) ++out.excluded;
+      if (hit.fate == Hit::Kept) out.contacts.push_back(hit.contact);
     }
   }
 }

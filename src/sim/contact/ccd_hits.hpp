@@ -14,26 +14,27 @@
 
 namespace clothcd::sim::detail {
 
+/// What one CCD pass found and cost.
+struct CcdPass {
+  std::vector<Contact> contacts;  ///< self hits first, each list in the detector's sorted order
+  long long excluded = 0;         ///< hits left out: tangled, or touching at t0
+  SelfCcdFigures self_ccd;        ///< of an unrestricted pass with self contact, else zero
+  CollisionPartTimes times;       ///< ccd_self_s, ccd_body_s and ccd_hits_s; the rest 0
+};
+
 class CcdHits {
  public:
   CcdHits(const ContactOptions& options, const ContactGeometry& geometry,
           ContactDetectors& detectors, const Crossings& crossings, const Escapes& escapes)
       : opt_(options), g_(geometry), det_(detectors), crossings_(crossings), escapes_(escapes) {}
 
-  /// All hits of the motion x0 -> x0 + h v, self ones first, each list in the detector's sorted
-  /// order; when `active` is given, only of the pairs with an active cloth vertex (all other
-  /// pairs move as when they were last tested without a hit).
-  std::vector<Contact> find(std::span<const Vec3> v, const std::vector<int>* active, bool self,
-                            bool body);
-
-  /// 1, or 0 in the late zone rounds: there only actual contact (the conservative kernels at
-  /// zero separation) still counts, so a zone that keeps every pair apart but cannot restore the
-  /// margin is accepted.
-  double sep_scale = 1.0;
-  /// Hits excluded this substep (tangled, or touching at t0); reset by the caller.
-  long long excluded = 0;
-  /// Where find() spends its time: ccd_self_s, ccd_body_s and ccd_hits_s grow, the rest stays 0.
-  CollisionPartTimes times;
+  /// The hits of the motion x0 -> x0 + h v; when `active` is given, only of the pairs with an
+  /// active cloth vertex (all other pairs move as when they were last tested without a hit).
+  /// `sep_scale` is 1, or 0 in the late zone rounds: there only actual contact (the conservative
+  /// kernels at zero separation) still counts, so a zone that keeps every pair apart but cannot
+  /// restore the margin is accepted.
+  CcdPass find(std::span<const Vec3> v, const std::vector<int>* active, double sep_scale, bool self,
+               bool body);
 
   // What becomes of one hit of a detector.
   struct Hit {
@@ -43,14 +44,14 @@ class CcdHits {
 
  private:
   void self_hits(std::span<const Vec3> x1, std::span<const Vec3> v, const std::vector<int>* active,
-                 std::vector<Contact>& out);
+                 double sep_scale, CcdPass& out);
   void body_hits(std::span<const Vec3> x1, std::span<const Vec3> v, const std::vector<int>* active,
-                 std::vector<Contact>& out);
+                 double sep_scale, CcdPass& out);
   template <class Query, class Distance, class Make>
-  Hit settle(bool dropped, bool tangled, double toi, const Query& query, Distance&& d0, Make&& make,
-             double reach) const;
-  [[nodiscard]] double separation(double d0) const;
-  void gather(std::initializer_list<const std::vector<Hit>*> lists, std::vector<Contact>& out);
+  Hit settle(double sep_scale, bool dropped, bool tangled, double toi, const Query& query,
+             Distance&& d0, Make&& make, double reach) const;
+  [[nodiscard]] double separation(double d0, double sep_scale) const;
+  static void gather(std::initializer_list<const std::vector<Hit>*> lists, CcdPass& out);
 
   const ContactOptions& opt_;
   const ContactGeometry& g_;

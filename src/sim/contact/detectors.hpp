@@ -1,10 +1,13 @@
 #pragma once
 // The contact stage's two detectors: cloth self contact (SelfDetector) and cloth against body
-// (PairDetector), created on first use with the stage's options and rebuilt on the substep start
-// once their trees have loosened (results do not depend on the trees, only the time).
+// (PairDetector), both started at a substep's start (created on the first one with the stage's
+// options, rebuilt on the start once their trees have loosened: results do not depend on the
+// trees, only the time). Every query goes through here, with its restriction as an argument.
 
 #include <array>
 #include <optional>
+#include <span>
+#include <vector>
 
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/sim/contact_handler.hpp"
@@ -17,24 +20,27 @@ class ContactDetectors {
   ContactDetectors(const ClothModel& model, const ContactOptions& options)
       : model_(model), opt_(options) {}
 
-  /// The self detector at a substep's start (created, or rebuilt on the start when loose).
-  SelfDetector& start_self(const ContactGeometry& g);
-  [[nodiscard]] SelfDetector& self() { return *self_; }
-  /// After an unrestricted self CCD pass: the first one after a build measures the tree's fit.
-  void self_pass_done();
+  /// At a substep's start: the self detector when `self` and the body detector when `body`
+  /// (created, or rebuilt on x0 when loose); `g` learns the body's topology.
+  void start(const SubstepContext& ctx, ContactGeometry& g, bool self, bool body);
 
-  /// The body detector (created on first use, on the substep's shapes); `g` learns its topology.
-  PairDetector& start_body(const SubstepContext& ctx, ContactGeometry& g);
-  [[nodiscard]] PairDetector& body() { return *body_; }
-  /// After the body proximity query (static boxes at the substep start): both trees rebuilt on
-  /// the start when either has loosened past its fit after the last build.
-  void body_proximity_done(const ContactGeometry& g);
-
-  /// Figures of the self detector since ContactHandler last took them.
-  SelfCcdFigures self_ccd_figures;
-  SelfProximityFigures self_proximity_figures;
+  /// Cloth self pairs within `d` at the substep start (unrestricted).
+  [[nodiscard]] ProximityResult self_proximity(const ContactGeometry& g, double d);
+  /// Cloth self CCD of x0 -> x1; with `active`, only of the pairs with an active vertex.
+  [[nodiscard]] DetectResult self_ccd(const ContactGeometry& g, std::span<const Vec3> x1,
+                                      const std::vector<int>* active);
+  /// Cloth-body pairs within `d` at the substep start (unrestricted); then both trees are
+  /// rebuilt on the start when either has loosened past its fit after the last build.
+  [[nodiscard]] PairProximityResult body_proximity(const ContactGeometry& g, double d);
+  /// Cloth-body CCD of x0 -> x1 against the body's b0 -> b1; with `active` (cloth vertices),
+  /// only of the pairs with an active vertex.
+  [[nodiscard]] PairDetectResult body_ccd(const ContactGeometry& g, std::span<const Vec3> x1,
+                                          const std::vector<int>* active);
 
  private:
+  void start_self(const ContactGeometry& g);
+  void start_body(const SubstepContext& ctx, ContactGeometry& g);
+
   const ClothModel& model_;
   const ContactOptions& opt_;
   std::optional<SelfDetector> self_;

@@ -46,9 +46,10 @@ std::vector<int> flagged(const std::vector<std::uint8_t>& flag) {
 
 // Impact zones (Provot 1997), each moved by one invertible linear map; a zone touching the
 // body or a pinned vertex follows those anchors (body points have infinite mass).
-void resolve_zones(const ContactGeometry& g, const ContactOptions& opt, const ZoneHits& hits,
-                   double& sep_scale, std::span<Vec3> v, std::vector<std::uint8_t>& changed,
-                   CollisionStats& st) {
+CollisionStats resolve_zones(const ContactGeometry& g, const ContactOptions& opt,
+                             const ZoneHits& hits, std::span<Vec3> v,
+                             std::vector<std::uint8_t>& changed) {
+  CollisionStats st;
   const std::span<const Vec3> x0 = g.x0, b0 = g.b0;
   const std::span<const double> inv_mass = g.inv_mass;
   const double h = g.h;
@@ -72,8 +73,8 @@ void resolve_zones(const ContactGeometry& g, const ContactOptions& opt, const Zo
   // after 3 rounds without fewer hits saved time; with rigid zones it cost crossings: twist
   // frames 38-43 had 0 / 0 / 0 / 0 / 5 / 5 crossing pairs without it, 171 by frame 41 with it.)
   for (int round = 0;; ++round) {
-    sep_scale = round >= std::min(opt.margin_rounds, opt.zone_rounds / 2) ? 0.0 : 1.0;
-    const std::vector<Contact> hs = hits(v, opt.full_passes ? nullptr : &active);
+    const double sep_scale = round >= std::min(opt.margin_rounds, opt.zone_rounds / 2) ? 0.0 : 1.0;
+    const std::vector<Contact> hs = hits(v, opt.full_passes ? nullptr : &active, sep_scale);
     if (hs.empty()) break;
     if (round == opt.zone_rounds) {
       st.unresolved = static_cast<long long>(hs.size());
@@ -181,6 +182,7 @@ void resolve_zones(const ContactGeometry& g, const ContactOptions& opt, const Zo
     }
     active = flagged(changed);
   }
+  return st;
 }
 
 }  // namespace clothcd::sim::detail

@@ -14,16 +14,19 @@
 
 namespace clothcd::sim::detail {
 
-/// The CCD hits of the motion x0 -> x0 + h v (restricted to the active vertices when given).
-using ZoneHits =
-    std::function<std::vector<Contact>(std::span<const Vec3> v, const std::vector<int>* active)>;
+/// The CCD hits of the motion x0 -> x0 + h v (restricted to the active vertices when given) at
+/// the CCD separation scaled by `sep_scale` (see CcdHits::find).
+using ZoneHits = std::function<std::vector<Contact>(
+    std::span<const Vec3> v, const std::vector<int>* active, double sep_scale)>;
 
-/// Runs zone rounds until `hits` finds none or `zone_rounds` have run (then the hits left are
-/// counted as unresolved in `st`); `changed` flags the vertices the last response moved, and
-/// `sep_scale` drops to 0 after `margin_rounds` (see CcdHits::sep_scale).
-void resolve_zones(const ContactGeometry& g, const ContactOptions& opt, const ZoneHits& hits,
-                   double& sep_scale, std::span<Vec3> v, std::vector<std::uint8_t>& changed,
-                   CollisionStats& st);
+/// Runs zone rounds until `hits` finds none or `zone_rounds` have run; `changed` flags the
+/// vertices the last response moved. The first `margin_rounds` (at most half the rounds) ask
+/// for the CCD separation, later ones for no contact (sep_scale 0). Returns the zone figures:
+/// zones (of the last round), largest_zone, zone_rounds, and as unresolved the hits left when
+/// the rounds ran out.
+CollisionStats resolve_zones(const ContactGeometry& g, const ContactOptions& opt,
+                             const ZoneHits& hits, std::span<Vec3> v,
+                             std::vector<std::uint8_t>& changed);
 
 /// The ids whose flag is set.
 std::vector<int> flagged(const std::vector<std::uint8_t>& flag);

@@ -9,18 +9,17 @@
 
 namespace clothcd::sim::detail {
 
-void ProximityContacts::find(ContactDetectors& detectors, const Escapes& escapes, bool self,
-                             bool body) {
+SelfProximityFigures ProximityContacts::find(ContactDetectors& detectors, const Escapes& escapes,
+                                             bool self, bool body) {
   contacts_.clear();
   constraints_.clear();
   couplings_.clear();
   const std::span<const Vec3> none;
+  SelfProximityFigures f;
   if (self) {
-    SelfDetector& det = detectors.start_self(g_);
-    SelfProximityFigures& f = detectors.self_proximity_figures;
     const ProximityResult r = [&] {
       PartClock clock(f.query_s);
-      return det.proximity(g_.x0, opt_.thickness);
+      return detectors.self_proximity(g_, opt_.thickness);
     }();
     ++f.calls;
     f.reused_pairs += static_cast<long long>(r.reused_pairs);
@@ -37,15 +36,13 @@ void ProximityContacts::find(ContactDetectors& detectors, const Escapes& escapes
     }
   }
   if (body) find_body(detectors, escapes);
+  return f;
 }
 
 // (cloth vertex, body face) pairs also give constraints, the others couplings.
 void ProximityContacts::find_body(ContactDetectors& detectors, const Escapes& escapes) {
   const std::span<const Vec3> none;
-  PairDetector& det = detectors.body();
-  det.clear_active();
-  const PairProximityResult r = det.proximity(g_.x0, g_.b0, opt_.thickness);
-  detectors.body_proximity_done(g_);
+  const PairProximityResult r = detectors.body_proximity(g_, opt_.thickness);
   const auto& cf = g_.cloth().faces();
   const auto& ce = g_.cloth().edges();
   for (const auto& p : r.vf_a_on_b) {

@@ -19,8 +19,10 @@ class ProximityContacts {
       : opt_(options), g_(geometry) {}
 
   /// This substep's contacts: cloth self pairs (seam-linked ones left out), then cloth-body
-  /// pairs (escaping vertices' left out), each list in the detectors' sorted order.
-  void find(ContactDetectors& detectors, const Escapes& escapes, bool self, bool body);
+  /// pairs (escaping vertices' left out), each list in the detectors' sorted order; both
+  /// detectors started. Returns what the self query cost (zero without `self`).
+  SelfProximityFigures find(ContactDetectors& detectors, const Escapes& escapes, bool self,
+                            bool body);
   /// Repulsion and friction (sorted pairs, Gauss-Seidel), sweeping until no pair approaches
   /// faster than its target (one sweep left coupled pairs approaching, and each became a CCD
   /// hit, a constraint and a vertex of every later pass's scope); friction in the first sweep.
