@@ -58,8 +58,8 @@ class Progress {
           "frame {}/{}: {} substeps, {} PCG iterations (max {}), {:.2f} s ({:.2f} s "
           "collisions), stretch {:.3f}, {} CCD hits, {} zones, intersections {}/{}, ETA {}\n",
           s.frame, total, s.substeps, s.pcg_iterations, s.max_pcg_iterations, s.seconds,
-          s.collision_seconds, s.max_stretch, s.ccd_hits, s.zones, s.self_intersections,
-          s.body_intersections, clock_text(eta));
+          s.collision.seconds, s.max_stretch, s.collision.ccd_hits, s.collision.zones,
+          s.self_intersections, s.body_intersections, clock_text(eta));
     }
     std::fflush(stderr);
   }
@@ -144,7 +144,7 @@ const bool registered = clothcd::app::register_command(
         int substeps = 0;
         for (const auto& f : frames) {
           seconds += f.seconds;
-          coll += f.collision_seconds;
+          coll += f.collision.seconds;
           worst_self = std::max(worst_self, f.self_intersections);
           worst_body = std::max(worst_body, f.body_intersections);
           iters += f.pcg_iterations;

@@ -109,13 +109,13 @@ SceneResult run_scene(const fs::path& file, int frames) {
       t.ccd += fs.self_ccd;
       t.proximity += fs.self_proximity;
       t.frame_seconds.push_back(fs.seconds);
-      t.collision_seconds.push_back(fs.collision_seconds);
+      t.collision_seconds.push_back(fs.collision.seconds);
       const SelfCcdFigures& c = fs.self_ccd;
       const SelfProximityFigures& p = fs.self_proximity;
       r.csv_rows.push_back(
           fmt::format("{},{},{},{},{:.6f},{:.6f},{},{},{},{:.6f},{:.6f},{:.6f},{},{},{},{:.6f}",
                       r.name, kSettings[i].name, fs.frame, fs.substeps, fs.seconds,
-                      fs.collision_seconds, c.calls, c.triangle_pairs, c.nodes_culled, c.refit_s,
+                      fs.collision.seconds, c.calls, c.triangle_pairs, c.nodes_culled, c.refit_s,
                       c.traversal_s, c.narrow_s, p.calls, p.reused_pairs, p.pairs, p.query_s));
     }
     for (std::size_t i = 1; i < k; ++i) {

@@ -72,15 +72,7 @@ FrameStats Simulation::advance_frame() {
     fs.max_pcg_iterations = std::max(fs.max_pcg_iterations, st.max_pcg_iterations);
     fs.halvings += st.halvings;
     fs.pcg_converged = fs.pcg_converged && st.converged;
-    fs.collision_seconds += st.collision.seconds;
-    fs.proximity_pairs += st.collision.proximity_pairs;
-    fs.ccd_hits += st.collision.ccd_hits;
-    fs.ccd_passes += st.collision.ccd_passes;
-    fs.zones += st.collision.zones;
-    fs.largest_zone = std::max(fs.largest_zone, st.collision.largest_zone);
-    fs.zone_rounds += st.collision.zone_rounds;
-    fs.unresolved += st.collision.unresolved;
-    fs.excluded += st.collision.excluded;
+    fs.collision += st.collision;
   }
   if (contact_) {
     fs.self_ccd = contact_->take_self_ccd_figures();

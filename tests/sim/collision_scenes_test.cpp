@@ -54,8 +54,8 @@ TEST(Simulation, ClothDroppedOnSphereStaysOutsideAndIntersectionFree) {
     ASSERT_TRUE(fs.finite) << "frame " << fs.frame;
     EXPECT_EQ(fs.self_intersections, 0) << "frame " << fs.frame;
     EXPECT_EQ(fs.body_intersections, 0) << "frame " << fs.frame;
-    EXPECT_EQ(fs.unresolved, 0) << "frame " << fs.frame;
-    contacts += fs.proximity_pairs;
+    EXPECT_EQ(fs.collision.unresolved, 0) << "frame " << fs.frame;
+    contacts += fs.collision.proximity_pairs;
     for (const Vec3& x : sim.state().x)
       ASSERT_GT(x.norm(), r_in) << "a vertex is inside the sphere at frame " << fs.frame;
   }
@@ -106,7 +106,7 @@ TEST(Simulation, StripFoldingOntoItselfStaysIntersectionFree) {
     ASSERT_TRUE(fs.finite);
     EXPECT_EQ(fs.self_intersections, 0) << "frame " << fs.frame;
     EXPECT_EQ(fs.body_intersections, 0) << "frame " << fs.frame;
-    self_contacts += fs.proximity_pairs;
+    self_contacts += fs.collision.proximity_pairs;
     for (const Vec3& x : sim.state().x)
       ASSERT_GT(x.y(), 0.0) << "below the floor at frame " << fs.frame;
   }
@@ -127,12 +127,12 @@ TEST(Simulation, ScopedCcdPassesGiveWhatFullPassesGive) {
   for (int f = 0; f < 12; ++f) {
     const FrameStats a = scoped.advance_frame();
     const FrameStats b = full.advance_frame();
-    ASSERT_EQ(a.ccd_hits, b.ccd_hits) << "frame " << a.frame;
-    ASSERT_EQ(a.ccd_passes, b.ccd_passes) << "frame " << a.frame;
+    ASSERT_EQ(a.collision.ccd_hits, b.collision.ccd_hits) << "frame " << a.frame;
+    ASSERT_EQ(a.collision.ccd_passes, b.collision.ccd_passes) << "frame " << a.frame;
     ASSERT_EQ(test::hash_positions(scoped.state().x), test::hash_positions(full.state().x))
         << "frame " << a.frame;
     substeps += a.substeps;
-    passes += a.ccd_passes;
+    passes += a.collision.ccd_passes;
   }
   EXPECT_GT(passes, substeps);  // later passes ran
 }

@@ -79,6 +79,41 @@ ClothMeshInput two_triangles(double gap) {
   return in;
 }
 
+TEST(CollisionStats, AddsEveryFigureAndKeepsTheLargestZone) {
+  CollisionStats a{.proximity_pairs = 1,
+                   .ccd_hits = 2,
+                   .ccd_passes = 3,
+                   .zones = 4,
+                   .largest_zone = 9,
+                   .zone_rounds = 5,
+                   .unresolved = 6,
+                   .excluded = 7,
+                   .seconds = 0.5};
+  const CollisionStats b{.proximity_pairs = 10,
+                         .ccd_hits = 20,
+                         .ccd_passes = 30,
+                         .zones = 40,
+                         .largest_zone = 8,
+                         .zone_rounds = 50,
+                         .unresolved = 60,
+                         .excluded = 70,
+                         .seconds = 0.25};
+  a += b;
+  EXPECT_EQ(a.proximity_pairs, 11);
+  EXPECT_EQ(a.ccd_hits, 22);
+  EXPECT_EQ(a.ccd_passes, 33);
+  EXPECT_EQ(a.zones, 44);
+  EXPECT_EQ(a.largest_zone, 9);
+  EXPECT_EQ(a.zone_rounds, 55);
+  EXPECT_EQ(a.unresolved, 66);
+  EXPECT_EQ(a.excluded, 77);
+  EXPECT_EQ(a.seconds, 0.75);
+  CollisionStats c = b;
+  c += CollisionStats{.largest_zone = 12};
+  EXPECT_EQ(c.largest_zone, 12);
+  EXPECT_EQ(c.ccd_hits, 20);
+}
+
 TEST(ContactHandler, StopsTwoTrianglesCrossing) {
   const ClothModel m(two_triangles(0.01), ClothMaterial{});
   std::vector<Vec3> v(6, Vec3::Zero());

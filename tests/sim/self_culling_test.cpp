@@ -72,7 +72,7 @@ TEST(SelfCulling, CollisionPartTimesAreDisjointPiecesOfTheStage) {
     EXPECT_GT(p.proximity_s, 0.0) << "frame " << f + 1;
     EXPECT_GT(p.ccd_self_s, 0.0) << "frame " << f + 1;
     EXPECT_GT(p.ccd_body_s, 0.0) << "frame " << f + 1;
-    EXPECT_LE(p.total(), s.collision_seconds + 1e-9) << "frame " << f + 1;
+    EXPECT_LE(p.total(), s.collision.seconds + 1e-9) << "frame " << f + 1;
     EXPECT_LE(s.self_ccd.refit_s + s.self_ccd.traversal_s + s.self_ccd.narrow_s,
               p.ccd_self_s + 1e-9)
         << "frame " << f + 1;
@@ -87,7 +87,7 @@ TEST(SelfCulling, EverySettingGivesTheSameFramesBitwise) {
     EXPECT_EQ(s.self_ccd.nodes_culled, 0) << "frame " << f + 1;
     EXPECT_GE(s.self_ccd.calls, s.substeps);  // the first pass of every substep is full
     EXPECT_GE(s.self_proximity.calls, s.substeps);
-    hits += s.ccd_hits;
+    hits += s.collision.ccd_hits;
     pairs_none += s.self_ccd.triangle_pairs;
   }
   EXPECT_GT(hits, 0);  // contact happened
@@ -100,8 +100,9 @@ TEST(SelfCulling, EverySettingGivesTheSameFramesBitwise) {
       const FrameStats &a = none.frames[f], &b = sound.frames[f];
       ASSERT_TRUE(same_bytes(none.x[f], sound.x[f])) << policy << " frame " << f + 1;
       ASSERT_TRUE(same_bytes(none.v[f], sound.v[f])) << policy << " frame " << f + 1;
-      EXPECT_EQ(a.ccd_hits, b.ccd_hits) << policy << " frame " << f + 1;
-      EXPECT_EQ(a.proximity_pairs, b.proximity_pairs) << policy << " frame " << f + 1;
+      EXPECT_EQ(a.collision.ccd_hits, b.collision.ccd_hits) << policy << " frame " << f + 1;
+      EXPECT_EQ(a.collision.proximity_pairs, b.collision.proximity_pairs)
+          << policy << " frame " << f + 1;
       EXPECT_EQ(a.self_ccd.calls, b.self_ccd.calls) << policy << " frame " << f + 1;
       EXPECT_EQ(a.self_proximity.calls, b.self_proximity.calls) << policy << " frame " << f + 1;
       EXPECT_EQ(a.self_proximity.pairs, b.self_proximity.pairs) << policy << " frame " << f + 1;
@@ -124,7 +125,7 @@ TEST(SelfCulling, TheTraversalFrontGivesTheSameFramesBitwise) {
       const FrameStats &a = plain.frames[f], &b = front.frames[f];
       ASSERT_TRUE(same_bytes(plain.x[f], front.x[f])) << culling << " frame " << f + 1;
       ASSERT_TRUE(same_bytes(plain.v[f], front.v[f])) << culling << " frame " << f + 1;
-      EXPECT_EQ(a.ccd_hits, b.ccd_hits) << culling << " frame " << f + 1;
+      EXPECT_EQ(a.collision.ccd_hits, b.collision.ccd_hits) << culling << " frame " << f + 1;
       EXPECT_EQ(a.self_ccd.calls, b.self_ccd.calls) << culling << " frame " << f + 1;
       EXPECT_EQ(a.self_ccd.triangle_pairs, b.self_ccd.triangle_pairs)
           << culling << " frame " << f + 1;

@@ -25,24 +25,18 @@ struct FrameStats {
   /// (more substeps than SubstepRule::min), pcg_tolerance otherwise.
   double pcg_tolerance = 0.0;
   double seconds = 0.0;
-  double collision_seconds = 0.0;
   double max_stretch = 0.0;  ///< at the end of the frame
   double body_displacement = 0.0;
   bool finite = true;
-  // Collision stage, summed over the frame's substeps (zero without collisions).
-  long long proximity_pairs = 0;
-  long long ccd_hits = 0;
-  int ccd_passes = 0;
-  int zones = 0;  ///< summed over substeps
-  int largest_zone = 0;
-  int zone_rounds = 0;
-  long long unresolved = 0;  ///< CCD hits left when zone rounds ran out
-  long long excluded = 0;    ///< CCD hits left out because their triangles already crossed
+  /// The collision stage, summed over the frame's substeps (zero without collisions); its
+  /// `seconds` is the manifest's collision_seconds, its `unresolved` the hits left when the zone
+  /// rounds ran out in the substeps' last halving.
+  CollisionStats collision;
   /// The self detector's full CCD passes and proximity queries of the frame (see
   /// SelfCcdFigures: counts depend on the run's history, so a resumed run's may differ).
   SelfCcdFigures self_ccd;
   SelfProximityFigures self_proximity;
-  /// Where collision_seconds went (see CollisionPartTimes).
+  /// Where collision.seconds went (see CollisionPartTimes).
   CollisionPartTimes collision_parts;
   /// Intersecting triangle pairs at the frame's end (-1: not counted).
   long long self_intersections = -1;
