@@ -24,6 +24,8 @@ class ContactDetectors {
   /// (created, or rebuilt on x0 when loose); `g` learns the body's topology.
   void start(const SubstepContext& ctx, ContactGeometry& g, bool self, bool body);
 
+  // The queries below need their detector started by this substep's start().
+
   /// Cloth self pairs within `d` at the substep start (unrestricted).
   [[nodiscard]] ProximityResult self_proximity(const ContactGeometry& g, double d);
   /// Cloth self CCD of x0 -> x1; with `active`, only of the pairs with an active vertex.
