@@ -1,9 +1,12 @@
 #pragma once
-// Positions of a frame sequence as the page stores them: 16-bit integers over the sequence's
-// bounding box, frame 0 as is and every later frame as the difference from the one before (modulo
-// 2^16, so exact), the low bytes of all values before their high bytes. Between frames most
-// vertices move by a few quanta, so the high bytes are nearly all 0 or 255 and the differences
-// compress several times better than the positions.
+// Positions of a frame sequence as the page stores them: 16-bit integers q over the sequence's
+// bounding box; frame 0 as is, frame 1 as its difference from frame 0, every later frame k as
+// its difference from the straight-line guess q[k-1] + (q[k-1] - q[k-2]) (all modulo 2^16, so
+// exact), each difference zigzag-coded (0, -1, 1, -2, ... as 0, 1, 2, 3, ...), the low bytes of
+// all values before their high bytes. Most vertices move smoothly by a few quanta a frame, so
+// nearly all high bytes are 0 and the data compresses well; the guess halves the size of a
+// body's frames (a dress run's: 1.14 -> 0.56 MB deflated for 31 frames) and costs the cloth's
+// nothing.
 
 #include <array>
 #include <cstdint>

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 #include <zlib.h>
+#include <Eigen/Core>
 
 #include <cstdint>
 #include <cstring>
@@ -17,6 +18,34 @@ namespace clothcd::test {
 struct PageData {
   nlohmann::json meta;
   std::string block;
+
+  /// Every frame of mesh `name` ("cloth", "body") decoded as the page's script decodes it:
+  /// frame 0 as is, then zigzag-coded differences from the straight-line guess, modulo 2^16.
+  [[nodiscard]] std::vector<std::vector<Eigen::Vector3d>> frames(const std::string& name) const {
+    const auto& mesh = meta.at("meshes").at(name);
+    const std::size_t n3 = mesh.at("vertices").get<std::size_t>() * 3;
+    const auto low = array<std::uint8_t>(name + "_low");
+    const auto high = array<std::uint8_t>(name + "_high");
+    std::vector<std::uint16_t> q(n3, 0), velocity(n3, 0);
+    std::vector<std::vector<Eigen::Vector3d>> out;
+    for (std::size_t k = 0; k * n3 < low.size(); ++k) {
+      out.emplace_back(n3 / 3);
+      for (std::size_t i = 0; i < n3; ++i) {
+        const unsigned code = low[k * n3 + i] | (high[k * n3 + i] << 8);
+        if (k == 0) {
+          q[i] = static_cast<std::uint16_t>(code);
+        } else {
+          const int s =
+              (code & 1u) != 0 ? -static_cast<int>(code >> 1) - 1 : static_cast<int>(code >> 1);
+          velocity[i] = static_cast<std::uint16_t>(velocity[i] + s);
+          q[i] = static_cast<std::uint16_t>(q[i] + velocity[i]);
+        }
+        out.back()[i / 3][i % 3] =
+            mesh.at("origin")[i % 3].get<double>() + q[i] * mesh.at("step")[i % 3].get<double>();
+      }
+    }
+    return out;
+  }
 
   template <typename T>
   [[nodiscard]] std::vector<T> array(const std::string& name) const {

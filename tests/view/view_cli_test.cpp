@@ -20,6 +20,7 @@ namespace clothcd {
 namespace {
 
 using test::CliScratch;
+using Vec3 = Eigen::Vector3d;
 
 // A sheet falling onto a sphere: contact with the body within three frames.
 const char* kScene = R"({"name": "drop", "frames": 3, "frame_dt": 0.04,
@@ -105,8 +106,7 @@ TEST(ViewCli, SimulationPageHoldsFramesBodyRestAndContact) {
   const auto& cm = m.at("meshes").at("cloth");
   const int n = cm.at("vertices").get<int>();
   ASSERT_EQ(n, 169);
-  const auto low = page.array<std::uint8_t>("cloth_low");
-  const auto high = page.array<std::uint8_t>("cloth_high");
+  const auto cloth = page.frames("cloth");
   const auto faces = page.array<std::uint32_t>("cloth_faces");
   const auto bits = page.array<std::uint8_t>("contact");
   const auto rest = page.array<float>("rest");
@@ -119,28 +119,20 @@ TEST(ViewCli, SimulationPageHoldsFramesBodyRestAndContact) {
                           static_cast<int>(body_faces_flat[i + 1]),
                           static_cast<int>(body_faces_flat[i + 2])});
   }
-  const auto blow = page.array<std::uint8_t>("body_low");
-  const auto bhigh = page.array<std::uint8_t>("body_high");
-  const int nb = bm.at("vertices").get<int>();
-  std::vector<std::uint16_t> q(n * 3, 0), qb(nb * 3, 0);
+  const auto bodies = page.frames("body");
+  ASSERT_EQ(cloth.size(), 4u);
+  ASSERT_EQ(bodies.size(), 4u);
   int contact_frames = 0;
   for (int k = 0; k < 4; ++k) {
     const TriangleMesh frame = read_mesh(dir / ("run/frame_000" + std::to_string(k) + ".obj"));
     ASSERT_EQ(faces.size(), frame.faces.size() * 3);
     for (int i = 0; i < n * 3; ++i) {
-      const std::size_t at = static_cast<std::size_t>(k) * n * 3 + i;
-      q[i] = static_cast<std::uint16_t>(q[i] + (low[at] | (high[at] << 8)));
       const double step = cm.at("step")[i % 3].get<double>();
-      const double x = cm.at("origin")[i % 3].get<double>() + q[i] * step;
-      EXPECT_NEAR(x, frame.vertices[i / 3][i % 3], 0.5 * step * (1 + 1e-9)) << k << " " << i;
+      EXPECT_NEAR(cloth[k][i / 3][i % 3], frame.vertices[i / 3][i % 3], 0.5 * step * (1 + 1e-9))
+          << k << " " << i;
     }
-    std::vector<Vec3> body(nb);
-    for (int i = 0; i < nb * 3; ++i) {
-      const std::size_t at = static_cast<std::size_t>(k) * nb * 3 + i;
-      qb[i] = static_cast<std::uint16_t>(qb[i] + (blow[at] | (bhigh[at] << 8)));
-      body[i / 3][i % 3] =
-          bm.at("origin")[i % 3].get<double>() + qb[i] * bm.at("step")[i % 3].get<double>();
-    }
+    const std::vector<Vec3>& body = bodies[k];
+    EXPECT_EQ(static_cast<int>(body.size()), bm.at("vertices").get<int>());
     // The flags come from the exact frame; the oracle's body from the page (to a quantum, far
     // below the contact distance, so only a pair within a quantum of h could differ: none here).
     const std::vector<bool> want = brute_force_contact(frame, body, body_faces, 0.01);

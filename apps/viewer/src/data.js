@@ -7,9 +7,14 @@ const TYPES = { u8: Uint8Array, u16: Uint16Array, i32: Int32Array, u32: Uint32Ar
 export async function loadPageData() {
   const meta = JSON.parse(document.getElementById('clothcd-meta').textContent);
   const text = document.getElementById('clothcd-data').textContent.trim();
-  const binary = atob(text);
-  const packed = new Uint8Array(binary.length);
-  for (let i = 0; i < binary.length; i++) packed[i] = binary.charCodeAt(i);
+  let packed;
+  if (typeof Uint8Array.fromBase64 === 'function') {
+    packed = Uint8Array.fromBase64(text);  // native, where the browser has it
+  } else {
+    const binary = atob(text);
+    packed = new Uint8Array(binary.length);
+    for (let i = 0; i < binary.length; i++) packed[i] = binary.charCodeAt(i);
+  }
   const stream = new Blob([packed]).stream().pipeThrough(new DecompressionStream('gzip'));
   const block = await new Response(stream).arrayBuffer();
   if (block.byteLength !== meta.data_bytes) {
@@ -22,26 +27,31 @@ export async function loadPageData() {
   return { meta, arrays, packedBytes: packed.length };
 }
 
-// Positions of every frame of a mesh: 16-bit values over the box origin + q * step, frame 0 as
-// is and later frames as differences modulo 2^16, low bytes and high bytes stored apart
+// Positions of every frame of a mesh: 16-bit values q over the box (x = origin + q * step);
+// frame 0 as is, frame 1 as its difference from frame 0, later frames as their difference from
+// q[k-1] + (q[k-1] - q[k-2]), zigzag-coded, modulo 2^16, low and high bytes stored apart
 // (src/view/quantize.hpp).
 export function decodeFrames(mesh, low, high) {
   const n3 = mesh.vertices * 3;
   const frames = low.length / n3;
   const q = new Uint16Array(n3);
+  const velocity = new Uint16Array(n3);
   const out = [];
-  const [ox, oy, oz] = mesh.origin;
-  const [sx, sy, sz] = mesh.step;
+  const origin = mesh.origin;
+  const step = mesh.step;
   for (let k = 0; k < frames; k++) {
     const base = k * n3;
     const p = new Float32Array(n3);
-    for (let i = 0; i < n3; i += 3) {
-      q[i] = q[i] + (low[base + i] | (high[base + i] << 8));
-      q[i + 1] = q[i + 1] + (low[base + i + 1] | (high[base + i + 1] << 8));
-      q[i + 2] = q[i + 2] + (low[base + i + 2] | (high[base + i + 2] << 8));
-      p[i] = ox + q[i] * sx;
-      p[i + 1] = oy + q[i + 1] * sy;
-      p[i + 2] = oz + q[i + 2] * sz;
+    for (let i = 0; i < n3; i++) {
+      const code = low[base + i] | (high[base + i] << 8);
+      if (k === 0) {
+        q[i] = code;
+      } else {
+        velocity[i] += (code & 1) ? -(code >>> 1) - 1 : code >>> 1;  // wraps modulo 2^16
+        q[i] += velocity[i];
+      }
+      const a = i % 3;
+      p[i] = origin[a] + q[i] * step[a];
     }
     out.push(p);
   }
