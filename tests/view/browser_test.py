@@ -129,7 +129,8 @@ def main():
                 check_sequence(state, page, os.path.join(out, "manifest.json"))
             shots[scene] = page
         steps = [("cloth_ball", os.path.join(a.data, "cloth-ball/frames/cloth_ball92.ply"),
-                  os.path.join(a.data, "cloth-ball/frames/cloth_ball93.ply"), []),
+                  os.path.join(a.data, "cloth-ball/frames/cloth_ball93.ply"),
+                  ["--culling", "sound", "--policy", "proposed"]),
                  ("dress_step", os.path.join(a.work, "dress-rumba/frame_0000.obj"),
                   os.path.join(a.work, "dress-rumba/frame_0001.obj"), ["--thickness", "0.001"])]
         for label, t0, t1, extra in steps:
@@ -145,7 +146,7 @@ def main():
         if a.screenshots:
             os.makedirs(a.screenshots, exist_ok=True)
             for page, fragment, png in [
-                    (shots["multilayer-kick"], "colour=strain", "viewer-simulation.png"),
+                    (shots["multilayer-kick"], "colour=strain&frame=1", "viewer-simulation.png"),
                     (shots["cloth_ball"], "hit=0", "viewer-detection.png")]:
                 browser.open("file://" + os.path.abspath(page) + "#" + fragment)
                 browser.wait_for(STATE + ".ready", timeout=120)

@@ -36,7 +36,9 @@ export class SequenceViewer {
     this.buildPanel();
     this.show(Math.min(Math.max(parseInt(params.get('frame') || '0', 10) || 0, 0),
       this.frames.length - 1));
-    view.fit(boxOf(this.cloth[this.index]));
+    const box = boxOf(this.cloth[this.index]);
+    if (this.body) box.union(boxOf(this.body[this.index]));
+    view.fit(box);
   }
 
   colourModes() {

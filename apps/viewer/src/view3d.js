@@ -17,8 +17,11 @@ export class View3D {
     this.controls.addEventListener('change', () => this.render());
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x303040, 1.0));
     const sun = new THREE.DirectionalLight(0xffffff, 1.1);
-    sun.position.set(1, 2, 3);
-    this.camera.add(sun);  // the light follows the camera: the side in view is always lit
+    // The light and its target follow the camera: it shines along the view from above right, so
+    // the side in view is always lit.
+    sun.position.set(1, 2, 0);
+    sun.target.position.set(0, 0, -3);
+    this.camera.add(sun, sun.target);
     this.scene.add(this.camera);
     this.frameCount = 0;
     window.addEventListener('resize', () => this.resize());
