@@ -38,8 +38,8 @@ int run(const ViewArgs& a) {
       throw clothcd::InputError("clothcd view: a detection step needs --t0, --t1 and --json");
     }
     s = clothcd::view::write_detection_page(a.t0, a.t1, a.json, a.out);
-    fmt::print("{}: {} hits, {} vertices' two frames, {}\n", a.out, s.hits, a.t0,
-               megabytes(s.bytes));
+    fmt::print("{}: {} hits, {} (geometry {} packed to {})\n", a.out, s.hits, megabytes(s.bytes),
+               megabytes(s.data_bytes), megabytes(s.packed_bytes));
   } else {
     clothcd::view::SequenceOptions opt;
     opt.first = a.first;

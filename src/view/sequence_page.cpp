@@ -222,12 +222,18 @@ PageSummary write_sequence_page(const fs::path& folder, const fs::path& out,
       summary.notes.push_back(
           fmt::format("scene file {} not found: no body and no strain colouring", sf.string()));
     } else {
-      scene = std::make_unique<sim::Scene>(sim::load_scene(sf));
-      if (static_cast<int>(scene->cloth.positions.size()) != n) {
+      try {
+        scene = std::make_unique<sim::Scene>(sim::load_scene(sf));
+      } catch (const InputError& e) {
+        // A run viewed elsewhere (its data moved, CLOTHCD_DATA unset) still has its frames.
+        summary.notes.push_back(
+            fmt::format("cannot read the scene ({}): no body and no strain colouring", e.what()));
+      }
+      if (scene && static_cast<int>(scene->cloth.positions.size()) != n) {
         summary.notes.push_back(fmt::format(
             "scene file {} has a cloth of {} vertices, the frames {}: no strain colouring",
             sf.string(), scene->cloth.positions.size(), n));
-      } else {
+      } else if (scene) {
         model = std::make_unique<sim::ClothModel>(scene->cloth, scene->material);
       }
     }
@@ -264,7 +270,10 @@ PageSummary write_sequence_page(const fs::path& folder, const fs::path& out,
   }
   double h = opt.contact_distance;
   if (h <= 0.0) {
-    h = m.contains("contact") ? m.at("contact").value("thickness", 0.002) : 0.002;
+    const auto c = m.find("contact");
+    h = c != m.end() && c->is_object() && c->contains("thickness") && c->at("thickness").is_number()
+            ? c->at("thickness").get<double>()
+            : 0.002;
   }
   if (opt.contact) {
     static const std::vector<std::pair<int, int>> no_links;

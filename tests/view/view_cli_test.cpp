@@ -148,6 +148,24 @@ TEST(ViewCli, SimulationPageHoldsFramesBodyRestAndContact) {
   EXPECT_GT(contact_frames, 0) << "the sheet never came near the sphere: the test checks nothing";
 }
 
+// A run whose scene file is gone or no longer reads (data moved) still gets a page: the cloth
+// alone, without strain colouring, and a note saying why.
+TEST(ViewCli, WithoutItsSceneARunShowsTheClothAlone) {
+  CliScratch dir;
+  dir.write("drop.json", kScene);
+  ASSERT_EQ(dir.run("simulate drop.json --out run --frames 1 --threads 1").code, 0);
+  dir.write("drop.json", "{\"name\": ");
+  const auto r = dir.run("view run --out page.html");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("cannot read the scene"), std::string::npos) << r.err;
+  const test::PageData page = test::read_page(CliScratch::slurp(dir / "page.html"));
+  EXPECT_FALSE(page.meta.at("meshes").contains("body"));
+  EXPECT_FALSE(page.meta.at("strain").get<bool>());
+  EXPECT_TRUE(page.meta.at("contact").get<bool>());
+  EXPECT_EQ(page.frames("cloth").size(), 2u);
+  ASSERT_EQ(page.meta.at("notes").size(), 1u);
+}
+
 TEST(ViewCli, DetectionPageListsTheResultsHits) {
   CliScratch dir;
   // Two triangles; the lone vertex 3 passes through triangle 0-1-2 during the step.
