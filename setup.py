@@ -14,6 +14,7 @@ import re
 import shutil
 import subprocess
 import sys
+import sysconfig
 
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
@@ -27,6 +28,43 @@ def project_version():
     if not match:
         raise RuntimeError("CMakeLists.txt: no project(clothcd VERSION ...)")
     return match.group(1)
+
+
+def missing_build_needs():
+    """What the build needs and this machine lacks, as (what, Debian package) pairs."""
+    missing = []
+    for tool, package in (("cmake", "cmake"), ("c++", "g++"), ("node", "nodejs")):
+        if shutil.which(tool) is None:
+            missing.append((f"the `{tool}` command", package))
+    if not os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")):
+        missing.append((f"the headers of Python {sys.version_info[0]}.{sys.version_info[1]}",
+                        "python3-dev"))
+    try:
+        import numpy  # noqa: F401
+    except ImportError:
+        missing.append((f"NumPy for {sys.executable} (Debian's is for /usr/bin/python3 and the "
+                        "venvs made from it with --system-site-packages)", "python3-numpy"))
+    pybind11_dirs = [os.path.join(prefix, sub, "cmake", "pybind11")
+                     for prefix in ("/usr", "/usr/local", sys.prefix)
+                     for sub in ("lib", "share", os.path.join("lib", "x86_64-linux-gnu"))]
+    try:
+        import pybind11
+        pybind11_dirs.append(pybind11.get_cmake_dir())
+    except ImportError:
+        pass
+    if not any(os.path.exists(os.path.join(d, "pybind11Config.cmake")) for d in pybind11_dirs):
+        missing.append(("pybind11's CMake package", "pybind11-dev"))
+    for package in ("three", "esbuild"):
+        if not os.path.exists(os.path.join(ROOT, "apps", "viewer", "node_modules", package,
+                                           "package.json")):
+            missing.append((f"the viewer's npm package {package} (apps/viewer/node_modules)",
+                            "npm ci in apps/viewer"))
+    return missing
+
+
+SETUP_HINT = ("Install them with `scripts/setup.sh full` (as root or with sudo): it installs the "
+              "Debian packages and the viewer's npm packages, and does nothing when all are "
+              "there. Then run `pip install . --no-build-isolation` again.")
 
 
 class CMakeExtension(Extension):
@@ -49,7 +87,14 @@ class CMakeBuild(build_ext):
             f"-DPython3_EXECUTABLE={sys.executable}",
         ] + os.environ.get("CLOTHCD_CMAKE_ARGS", "").split()
         jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL") or str(os.cpu_count() or 1)
-        subprocess.run(configure, check=True)
+        missing = missing_build_needs()
+        if missing:
+            lines = "\n".join(f"  - {what} (Debian: {pkg})" for what, pkg in missing)
+            raise SystemExit(f"clothcd: cannot build the Python module; missing:\n{lines}\n"
+                             f"{SETUP_HINT}")
+        if subprocess.run(configure).returncode != 0:
+            raise SystemExit(f"clothcd: CMake could not configure the build (see above). "
+                             f"{SETUP_HINT}")
         subprocess.run(["cmake", "--build", build, "--target", "_clothcd", "-j", jobs], check=True)
         built = glob.glob(os.path.join(build, "python", "clothcd", "_clothcd*.so")) + glob.glob(
             os.path.join(build, "python", "clothcd", "_clothcd*.pyd"))

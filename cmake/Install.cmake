@@ -8,12 +8,13 @@ install(TARGETS clothcd EXPORT clothcdTargets
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # Headers of code that is not installed (the experiment harness, linked into the CLI only) or
 # that serves the CLI, benchmarks and tests rather than users (CCD query files, procedural
-# scenes, frame rendering) stay out of the install.
+# scenes, frame rendering, the viewer page) stay out of the install.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/clothcd DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   PATTERN experiment EXCLUDE
   PATTERN query_csv.hpp EXCLUDE
   PATTERN procedural.hpp EXCLUDE
-  PATTERN render.hpp EXCLUDE)
+  PATTERN render.hpp EXCLUDE
+  PATTERN view EXCLUDE)
 install(EXPORT clothcdTargets NAMESPACE clothcd:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/clothcd)
 
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/clothcdConfig.cmake.in

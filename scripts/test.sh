@@ -3,7 +3,8 @@
 # ctest suites (labels unit, data, slow, install; the command-line tests are unit and slow tests)
 # plus the format check, printing the wall time of each stage and how many tests ran and skipped.
 #   --full  also builds and tests the Python module (label python), runs the minutes-long property
-#           sweeps (label sweep), builds the benchmarks and a clang tree with AddressSanitizer +
+#           sweeps (label sweep) and the viewer pages in headless Chromium (label browser), builds
+#           the benchmarks and a clang tree with AddressSanitizer +
 #           UndefinedBehaviorSanitizer, runs the unit tests again there and fuzzes each libFuzzer
 #           target for a fixed number of runs from a fixed seed (the same inputs every time).
 # Data-driven tests read CLOTHCD_DATA (default ../shared/data). Where CI is set, missing data and
@@ -73,11 +74,14 @@ cmake --build build/release -j "$jobs"
 cmake --build build/release --target format-check
 
 stage "Release tests"
-CLOTHCD_DATA=$data run_ctest --test-dir build/release -LE sweep
+CLOTHCD_DATA=$data run_ctest --test-dir build/release -LE 'sweep|browser'
 
 if [ "$full" = 1 ]; then
   stage "Property sweeps (label sweep)"
   CLOTHCD_DATA=$data run_ctest --test-dir build/release -L sweep
+
+  stage "Viewer pages in headless Chromium (label browser)"
+  CLOTHCD_DATA=$data run_ctest --test-dir build/release -L browser
 
   stage "Sanitizer + fuzzer build (clang, ASan + UBSan)"
   # A tree configured with another compiler cannot switch in place.

@@ -26,6 +26,7 @@ from ._clothcd import (
     read_query_csv,
     simulate,
     vertex_face_ccd,
+    view,
     write_mesh,
 )
 from .frames import read_frames, read_manifest
@@ -52,5 +53,6 @@ __all__ = [
     "read_query_csv",
     "simulate",
     "vertex_face_ccd",
+    "view",
     "write_mesh",
 ]

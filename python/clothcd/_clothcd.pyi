@@ -208,3 +208,17 @@ def simulate(
     resume: bool = False,
     keep_states: int = 0,
 ) -> List[Dict[str, Any]]: ...
+def view(
+    dir: Optional[_Path] = None,
+    *,
+    out: _Path,
+    t0: Optional[_Path] = None,
+    t1: Optional[_Path] = None,
+    json: Optional[_Path] = None,
+    first: int = 0,
+    last: Optional[int] = None,
+    step: int = 1,
+    contact_distance: float = 0.0,
+    no_body: bool = False,
+    no_contact: bool = False,
+) -> Dict[str, Any]: ...

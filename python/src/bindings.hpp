@@ -16,6 +16,7 @@ void bind_detect(pybind11::module_& m);
 void bind_ccd(pybind11::module_& m);
 void bind_cone(pybind11::module_& m);
 void bind_sim(pybind11::module_& m);
+void bind_view(pybind11::module_& m);
 
 /// Runs work without the GIL, in an arena of `threads` workers (0: TBB's default, all cores).
 class Workers {

@@ -28,4 +28,5 @@ PYBIND11_MODULE(_clothcd, m) {
   clothcd::python::bind_ccd(m);
   clothcd::python::bind_cone(m);
   clothcd::python::bind_sim(m);
+  clothcd::python::bind_view(m);
 }

@@ -1,12 +1,15 @@
-// Orthographic z-buffer rasterizer and a minimal PNG encoder (stored deflate blocks).
+// Orthographic z-buffer rasterizer; PNG files through libpng.
 #include "clothcd/sim/render.hpp"
 
 #include <fmt/format.h>
+#include <png.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "clothcd/core/atomic_file.hpp"
 #include "clothcd/core/error.hpp"
@@ -40,37 +43,6 @@ Camera camera_for(const std::string& view) {
   c.right = f.cross(up).normalized();
   c.up = c.right.cross(f).normalized();
   return c;
-}
-
-std::uint32_t crc32(const unsigned char* data, std::size_t n, std::uint32_t crc = 0) {
-  static const auto table = [] {
-    std::array<std::uint32_t, 256> t{};
-    for (std::uint32_t i = 0; i < 256; ++i) {
-      std::uint32_t c = i;
-      for (int k = 0; k < 8; ++k)
-        c = (c & 1u) != 0 ? 0xedb88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  crc = ~crc;
-  for (std::size_t i = 0; i < n; ++i)
-    crc = table[(crc ^ data[i]) & 0xffu] ^ (crc >> 8);
-  return ~crc;
-}
-
-void put32(std::vector<unsigned char>& out, std::uint32_t v) {
-  for (int s = 24; s >= 0; s -= 8)
-    out.push_back(static_cast<unsigned char>((v >> s) & 0xffu));
-}
-
-void chunk(std::vector<unsigned char>& out, const char* type,
-           const std::vector<unsigned char>& data) {
-  put32(out, static_cast<std::uint32_t>(data.size()));
-  const std::size_t start = out.size();
-  out.insert(out.end(), type, type + 4);
-  out.insert(out.end(), data.begin(), data.end());
-  put32(out, crc32(out.data() + start, out.size() - start));
 }
 
 }  // namespace
@@ -147,45 +119,49 @@ Image render(const std::vector<RenderMesh>& meshes, const RenderOptions& opt) {
   return img;
 }
 
+// libpng encodes into memory; the bytes then go through the atomic writer like every output.
 void write_png(const std::filesystem::path& path, const Image& img) {
-  std::vector<unsigned char> raw;
-  const std::size_t row = static_cast<std::size_t>(img.width) * 3;
-  raw.reserve((row + 1) * img.height);
-  for (int y = 0; y < img.height; ++y) {
-    raw.push_back(0);  // filter: none
-    raw.insert(raw.end(), img.rgb.begin() + static_cast<std::ptrdiff_t>(y * row),
-               img.rgb.begin() + static_cast<std::ptrdiff_t>((y + 1) * row));
+  if (img.width <= 0 || img.height <= 0 ||
+      img.rgb.size() != static_cast<std::size_t>(img.width) * img.height * 3) {
+    throw std::invalid_argument(
+        fmt::format("write_png: {}x{} image with {} bytes", img.width, img.height, img.rgb.size()));
   }
-  // zlib stream of stored blocks, then Adler-32 of the raw bytes.
-  std::vector<unsigned char> z{0x78, 0x01};
-  std::size_t pos = 0;
-  do {
-    const std::size_t len = std::min<std::size_t>(65535, raw.size() - pos);
-    const bool last = pos + len == raw.size();
-    z.push_back(last ? 1 : 0);
-    z.push_back(static_cast<unsigned char>(len & 0xffu));
-    z.push_back(static_cast<unsigned char>(len >> 8));
-    z.push_back(static_cast<unsigned char>(~len & 0xffu));
-    z.push_back(static_cast<unsigned char>((~len >> 8) & 0xffu));
-    z.insert(z.end(), raw.begin() + static_cast<std::ptrdiff_t>(pos),
-             raw.begin() + static_cast<std::ptrdiff_t>(pos + len));
-    pos += len;
-  } while (pos < raw.size());
-  std::uint32_t s1 = 1, s2 = 0;
-  for (unsigned char b : raw) {
-    s1 = (s1 + b) % 65521u;
-    s2 = (s2 + s1) % 65521u;
+  std::string bytes;
+  std::string error;
+  png_structp png = png_create_write_struct(
+      PNG_LIBPNG_VER_STRING, &error,
+      [](png_structp p, png_const_charp msg) {
+        *static_cast<std::string*>(png_get_error_ptr(p)) = msg;
+        png_longjmp(p, 1);
+      },
+      nullptr);
+  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
+  if (png == nullptr || info == nullptr) {
+    png_destroy_write_struct(&png, nullptr);
+    throw OutputError(fmt::format("cannot write '{}': libpng: out of memory", path.string()));
   }
-  put32(z, (s2 << 16) | s1);
-  std::vector<unsigned char> png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  std::vector<unsigned char> ihdr;
-  put32(ihdr, static_cast<std::uint32_t>(img.width));
-  put32(ihdr, static_cast<std::uint32_t>(img.height));
-  ihdr.insert(ihdr.end(), {8, 2, 0, 0, 0});  // 8-bit RGB, deflate, no filter, no interlace
-  chunk(png, "IHDR", ihdr);
-  chunk(png, "IDAT", z);
-  chunk(png, "IEND", {});
-  write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+  std::vector<png_const_bytep> rows(img.height);
+  for (int y = 0; y < img.height; ++y)
+    rows[y] = img.rgb.data() + static_cast<std::size_t>(y) * img.width * 3;
+  // No C++ object with a destructor is created between setjmp and the last libpng call.
+  if (setjmp(png_jmpbuf(png)) != 0) {
+    png_destroy_write_struct(&png, &info);
+    throw OutputError(fmt::format("cannot write '{}': libpng: {}", path.string(), error));
+  }
+  png_set_write_fn(
+      png, &bytes,
+      [](png_structp p, png_bytep data, png_size_t n) {
+        static_cast<std::string*>(png_get_io_ptr(p))->append(reinterpret_cast<char*>(data), n);
+      },
+      nullptr);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(img.width), static_cast<png_uint_32>(img.height),
+               8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  png_write_image(png, const_cast<png_bytepp>(rows.data()));
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  write_file_atomic(path, bytes);
 }
 
 }  // namespace clothcd::sim

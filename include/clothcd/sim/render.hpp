@@ -1,8 +1,7 @@
 #pragma once
 /// @file
 /// A small software renderer for looking at simulated frames: orthographic view, z-buffer,
-/// two-sided Lambert shading, written as an RGB PNG (stored, uncompressed deflate blocks, so no
-/// image library is needed).
+/// two-sided Lambert shading, written as an RGB PNG (libpng).
 
 #include <array>
 #include <filesystem>
