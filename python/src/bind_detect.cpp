@@ -234,7 +234,7 @@ class PySelfDetector {
     workers_.run([&] { det_->set_active_faces(f); });
   }
   void clear_active() {
-    workers_.run([&] { det_->clear_active_faces(); });
+    workers_.run([&] { det_->clear_active(); });
   }
   void rebuild(const ArrayLike& V) {
     const PointsArg a(V, "V");

@@ -19,6 +19,7 @@
 #include "ccd/distances.hpp"
 #include "clearance.hpp"
 #include "clothcd/ccd/proximity.hpp"
+#include "clothcd/detect/names.hpp"
 #include "clothcd/research/names.hpp"
 #include "contour.hpp"
 #include "front.hpp"
@@ -70,6 +71,21 @@ void check_options(const DetectOptions& o) {
   }
   if (o.cull_min_triangles < 0) {
     throw InputError(fmt::format("cull_min_triangles must be >= 0, got {}", o.cull_min_triangles));
+  }
+  if (o.reuse_distance > 0 && o.research.unsound_culling != research::UnsoundCulling::None) {
+    throw InputError(
+        "reuse distance: the unsound culling rules may cull the pairs it keeps; use culling none "
+        "or sound with it");
+  }
+}
+
+// The tree is built once, at construction: options naming another build are refused.
+void check_same_build(BvhBuild built, BvhBuild asked, std::string_view call) {
+  if (asked != built) {
+    throw InputError(fmt::format(
+        "{}: the BVH build is fixed at construction ({}), got {}; construct a detector for "
+        "another build",
+        call, to_string(built), to_string(asked)));
   }
 }
 
@@ -135,6 +151,13 @@ struct SelfDetector::Impl {
     bvh = Bvh(topo, reference, o.build);
     orphans = detail::find_orphans(topo);
     owner = detail::Ownership(topo);
+  }
+
+  // opt.linked_vertices normalized, once per change of the options (throws for a bad id).
+  void update_links() {
+    if (links_current) return;
+    links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
+    links_current = true;
   }
 
   [[nodiscard]] bool cones_used(Rule mode) const { return mode != Rule::None; }
@@ -601,6 +624,7 @@ struct SelfDetector::Impl {
     for (std::size_t k = 0; k < configs.size(); ++k) {
       const DetectOptions& c = configs[k];
       check_options(c);
+      check_same_build(opt.build, c.build, fmt::format("detect_each: configuration {}", k));
       if (c.reuse_distance != 0 || c.research.verify) {
         throw InputError(fmt::format(
             "detect_each: configuration {} sets reuse_distance or verify (both must be off)", k));
@@ -742,10 +766,7 @@ struct SelfDetector::Impl {
 
   DetectResult detect(detail::PointsIn p0, detail::PointsIn p1) {
     step.update(p0, p1, topo.num_vertices(), "positions at t0", "positions at t1");
-    if (!links_current) {
-      links = detail::sorted_links(opt.linked_vertices, topo.num_vertices());
-      links_current = true;
-    }
+    update_links();
     DetectResult res;
     DetectStats& st = res.stats;
     refit(st);
@@ -790,12 +811,13 @@ struct SelfDetector::Impl {
       throw InputError(fmt::format("proximity distance must be finite and >= 0, got {}", h));
     }
     step.update_static(p, topo.num_vertices(), "positions");
+    update_links();
     RefitOptions ro;
     ro.thickness = h;
     ro.cones = false;  // cones carry no distance information (docs/algorithms.md 1.1)
     bvh.refit(v0, ro);
     bvh_call = 0;
-    detail::FeatureContext ctx = detail::proximity_context(topo, v0, h);
+    detail::FeatureContext ctx = detail::proximity_context(topo, v0, h, links);
     boxes.update(ctx, step);
     struct Buffer {
       std::vector<ProximityResult::VertexFace> vf;
@@ -803,11 +825,14 @@ struct SelfDetector::Impl {
       detail::FaceBoundBatch bounds;  // a piece's triangle pairs past the box test
     };
     tbb::enumerable_thread_specific<Buffer> locals;
+    // Linked pairs are left out as detect() leaves them out (DetectOptions::linked_vertices).
     auto kvf = [&](int v, int f, const Face& t, Buffer& out) {
+      if (!ctx.links.empty() && ctx.vf_linked(v, f)) return;
       const double d = detail::point_triangle_within(v0[v], v0[t[0]], v0[t[1]], v0[t[2]], h);
       if (d <= h) out.vf.push_back({v, f, d});
     };
     auto kee = [&](int a, int b, const Edge& ea, const Edge& eb, Buffer& out) {
+      if (!ctx.links.empty() && ctx.ee_linked(a, b)) return;
       const double d = detail::edge_edge_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
       if (d <= h) out.ee.push_back({a, b, d});
     };
@@ -1000,7 +1025,7 @@ void SelfDetector::set_active_faces(std::span<const int> faces) {
 void SelfDetector::set_active_vertices(std::span<const int> vertices) {
   impl_->set_active_vertices(vertices);
 }
-void SelfDetector::clear_active_faces() {
+void SelfDetector::clear_active() {
   impl_->restricted = false;
 }
 void SelfDetector::rebuild(const Positions& reference) {
@@ -1014,9 +1039,8 @@ const DetectOptions& SelfDetector::options() const {
 }
 void SelfDetector::set_options(const DetectOptions& options) {
   check_options(options);
-  const BvhBuild build = impl_->opt.build;
+  check_same_build(impl_->opt.build, options.build, "set_options");
   impl_->opt = options;
-  impl_->opt.build = build;
   impl_->links_current = false;
   impl_->reuse.valid = false;
   if (!options.reuse_front) impl_->front.clear();

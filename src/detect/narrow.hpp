@@ -504,10 +504,12 @@ inline FeatureContext ccd_context(const Topology& topo, std::span<const Eigen::V
   return ctx;
 }
 
-/// The context of a proximity query at distance h at positions v (boxes only: no kernel runs).
+/// The context of a proximity query at distance h at positions v (boxes only: no kernel runs;
+/// `links` as for ccd_context).
 inline FeatureContext proximity_context(const Topology& topo, std::span<const Eigen::Vector3d> v,
-                                        double h) {
+                                        double h, std::span<const std::pair<int, int>> links = {}) {
   FeatureContext ctx;
+  ctx.links = links;
   ctx.topo = &topo;
   ctx.v0 = v;
   ctx.v1 = v;

@@ -13,6 +13,7 @@
 #include "ccd/distances.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/detect/names.hpp"
 #include "clothcd/detect/oracle.hpp"
 #include "front.hpp"
 #include "narrow.hpp"
@@ -524,9 +525,13 @@ const DetectOptions& PairDetector::options() const {
 }
 void PairDetector::set_options(const DetectOptions& options) {
   check_pair_options(options);
-  const BvhBuild build = impl_->opt.build;
+  if (options.build != impl_->opt.build) {
+    throw InputError(fmt::format(
+        "PairDetector::set_options: the BVH build is fixed at construction ({}), got {}; "
+        "construct a detector for another build",
+        to_string(impl_->opt.build), to_string(options.build)));
+  }
   impl_->opt = options;
-  impl_->opt.build = build;
   if (!options.reuse_front) impl_->front.clear();
 }
 const Topology& PairDetector::topology_a() const {

@@ -75,7 +75,7 @@ void check_restricted(const ProceduralScene& s, const DetectResult& full, const 
       const DetectResult r = det.detect(s.v_t0, s.v_t1);
       EXPECT_EQ(r.vf, ref.vf);
       EXPECT_EQ(r.ee, ref.ee);
-      det.clear_active_faces();
+      det.clear_active();
       const DetectResult all = det.detect(s.v_t0, s.v_t1);
       EXPECT_EQ(all.vf, full.vf);
       EXPECT_EQ(all.ee, full.ee);
@@ -171,7 +171,7 @@ TEST(DetectApi, ReusedDetectorEqualsBruteForceOverASequenceOfCalls) {
           }
           det.set_active_vertices(active);
         } else {
-          det.clear_active_faces();
+          det.clear_active();
         }
         const DetectResult r = det.detect(x0, x1);
         const DetectResult all = brute_force_detect(topo, x0, x1);

@@ -71,7 +71,9 @@ TEST(DetectEach, EqualsOneDetectPerConfiguration) {
           DetectOptions base;
           base.build = build;
           SelfDetector det(s.faces, s.num_vertices, s.v_t0, base);
-          const auto configs = all_configs(thickness);
+          auto configs = all_configs(thickness);
+          for (DetectOptions& c : configs)
+            c.build = build;  // the detector's build: another one is refused
           const auto each = det.detect_each(s.v_t0, s.v_t1, configs);
           ASSERT_EQ(each.size(), configs.size());
           // The detector's own options are back.
@@ -149,11 +151,14 @@ TEST(DetectEach, RefusesConfigurationsThatShareNoNarrowPhase) {
   b = a;
   b.thickness = -1;
   refused({b});
+  b = a;
+  b.build = BvhBuild::Patch;  // the detector's tree is the spatial build
+  refused({b});
   refused(std::vector<DetectOptions>(65, a));
   const std::vector<int> active{0, 1};
   det.set_active_faces(active);
   refused({a});
-  det.clear_active_faces();
+  det.clear_active();
   EXPECT_TRUE(det.detect_each(s.v_t0, s.v_t1, std::vector<DetectOptions>{}).empty());
   // Positions of the wrong size are refused too, with the positions named.
   const Positions short_one = s.v_t0.topRows(3);

@@ -239,8 +239,8 @@ TEST(ReuseFront, DetectorResultsUnchanged) {
               ref.set_active_faces(some);
               expect_same_as_without_front(det.detect(x0, x1), ref.detect(x0, x1),
                                            what + " restricted");
-              det.clear_active_faces();
-              ref.clear_active_faces();
+              det.clear_active();
+              ref.clear_active();
             }
             if (k == 2) {
               const ProximityResult pa = det.proximity(x1, thickness);

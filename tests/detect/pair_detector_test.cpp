@@ -233,6 +233,10 @@ TEST(PairDetector, RefusesOptionsItCannotHonour) {
   o = {};
   o.research.unsound_culling = research::UnsoundCulling::Cone;
   EXPECT_THROW(det.set_options(o), InputError);
+  o = {};
+  o.build = BvhBuild::Patch;  // built spatial: the build is fixed at construction
+  EXPECT_THROW(det.set_options(o), InputError);
+  EXPECT_EQ(det.options().build, BvhBuild::Spatial);
   EXPECT_THROW(det.set_active_vertices(std::vector<int>{s.a.nv()}), InputError);
   EXPECT_THROW((void)det.proximity(s.a.v0, s.b.v0, -1.0), InputError);
 }
