@@ -16,7 +16,7 @@
 #include <utility>
 
 #include "clothcd/bvh/bvh.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/topology.hpp"
 

@@ -14,16 +14,22 @@
 #include <tuple>
 
 #include "api_scenes.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/oracle.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "clothcd/research/names.hpp"
 #include "support/detect_stats.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace api_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 using namespace clothcd::test;
 
@@ -373,5 +379,5 @@ TEST(DetectApi, LinkedVertexOutOfRangeIsAnInputError) {
   EXPECT_NO_THROW((void)det.detect(s.v_t0, s.v_t1));
 }
 
-}  // namespace
+}  // namespace api_test
 }  // namespace clothcd

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "clothcd/research/detector.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
 #include "clothcd/mesh/io.hpp"
@@ -11,7 +12,12 @@
 #include "support/detect_stats.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace detect_each_data_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 TEST(DetectEachData, ClothBallEqualsOneDetectPerConfiguration) {
   CLOTHCD_REQUIRE_DATA(root, "cloth-ball");
@@ -49,5 +55,5 @@ TEST(DetectEachData, ClothBallEqualsOneDetectPerConfiguration) {
   }
 }
 
-}  // namespace
+}  // namespace detect_each_data_test
 }  // namespace clothcd

@@ -9,15 +9,21 @@
 #include <cstdint>
 #include <vector>
 
+#include "clothcd/research/detector.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "clothcd/research/names.hpp"
 #include "support/detect_stats.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace detect_each_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 using research::ConeRule;
 using research::CullingRule;
@@ -165,5 +171,5 @@ TEST(DetectEach, RefusesConfigurationsThatShareNoNarrowPhase) {
   EXPECT_THROW((void)det.detect_each(short_one, s.v_t1, std::vector<DetectOptions>{a}), InputError);
 }
 
-}  // namespace
+}  // namespace detect_each_test
 }  // namespace clothcd

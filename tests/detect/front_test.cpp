@@ -15,7 +15,7 @@
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/bvh/traverse.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "clothcd/mesh/topology.hpp"
 #include "detect/front.hpp"
 

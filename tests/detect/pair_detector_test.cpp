@@ -12,7 +12,7 @@
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
+#include "clothcd/research/oracle.hpp"
 
 namespace clothcd {
 namespace {
@@ -215,12 +215,6 @@ TEST(PairDetector, RefusesOptionsItCannotHonour) {
   o.culling = Culling::Sound;
   EXPECT_THROW(make(o), InputError);
   o = {};
-  o.research.verify = true;
-  EXPECT_THROW(make(o), InputError);
-  o = {};
-  o.research.optimal_cones = true;
-  EXPECT_THROW(make(o), InputError);
-  o = {};
   o.reuse_distance = 0.001;
   EXPECT_THROW(make(o), InputError);
   o = {};
@@ -231,7 +225,7 @@ TEST(PairDetector, RefusesOptionsItCannotHonour) {
   EXPECT_THROW(make(o), InputError);
   PairDetector det(s.a.faces, s.a.nv(), s.a.v0, s.b.faces, s.b.nv(), s.b.v0);
   o = {};
-  o.research.unsound_culling = research::UnsoundCulling::Cone;
+  o.culling = Culling::Sound;
   EXPECT_THROW(det.set_options(o), InputError);
   o = {};
   o.build = BvhBuild::Patch;  // built spatial: the build is fixed at construction

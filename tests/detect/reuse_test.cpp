@@ -12,12 +12,18 @@
 #include <random>
 
 #include "api_scenes.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace reuse_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 using namespace clothcd::test;
 
@@ -357,5 +363,5 @@ TEST(ProximityReuse, RejectsBadDistances) {
   }
 }
 
-}  // namespace
+}  // namespace reuse_test
 }  // namespace clothcd

@@ -16,7 +16,7 @@
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
+#include "clothcd/research/oracle.hpp"
 #include "clothcd/experiment/experiment.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "support/files.hpp"

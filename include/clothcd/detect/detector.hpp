@@ -13,6 +13,10 @@
 #include "clothcd/detect/types.hpp"
 
 namespace clothcd {
+namespace detail {
+struct SelfCore;
+struct SelfAccess;
+}  // namespace detail
 
 /// n x 3 vertex positions, one row per vertex.
 ///
@@ -105,25 +109,6 @@ class SelfDetector {
   void rebuild(const Positions& reference);
   void rebuild(std::span<const Eigen::Vector3d> reference);
 
-  /// The step v_t0 -> v_t1 under each of several options, for measuring culling rules and cone
-  /// policies against each other (the experiment's counting pass). Result k holds what
-  /// set_options(configs[k]) followed by detect() reports: the same collisions and the same
-  /// counters of DetectStats. The work differs: every configuration refits its cones and walks
-  /// its culling rule over the nodes, but the node pairs' box tests and the narrow phase run
-  /// once, over the pairs that some configuration keeps, each pair's results counted for the
-  /// configurations that keep it. time_refit is each configuration's own refit; time_traverse
-  /// and time_narrow are NaN (shared work; detect() measures them). The configurations may
-  /// differ only in policy, culling, cull_min_triangles and the research options'
-  /// unsound_culling and optimal_cones;
-  /// reuse_distance must be 0, verify off, the build the detector's, at most 64 of them and no
-  /// active restriction. Throws InputError otherwise. The detector's own options are left as they
-  /// were.
-  [[nodiscard]] std::vector<DetectResult> detect_each(const Positions& v_t0, const Positions& v_t1,
-                                                      std::span<const DetectOptions> configs);
-  [[nodiscard]] std::vector<DetectResult> detect_each(std::span<const Eigen::Vector3d> v_t0,
-                                                      std::span<const Eigen::Vector3d> v_t1,
-                                                      std::span<const DetectOptions> configs);
-
   [[nodiscard]] const DetectOptions& options() const;
   /// Replaces the options for the following calls. The BVH build is fixed at construction: an
   /// options.build other than options().build throws InputError (rebuild() keeps the build; a
@@ -133,8 +118,8 @@ class SelfDetector {
   [[nodiscard]] const Bvh& bvh() const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  friend struct detail::SelfAccess;
+  std::unique_ptr<detail::SelfCore> impl_;
 };
 
 /// Collisions between two meshes A (e.g. a garment) and B (e.g. a body); no self-collisions.
@@ -160,9 +145,9 @@ class PairDetector {
  public:
   /// Builds both topologies and box-only BVHs (split on the references). Throws InputError on
   /// bad faces, a reference of the wrong size, or options it cannot honour between two meshes:
-  /// a culling other than Culling::None (cones cull self tests only), research options other than
-  /// their defaults, reuse_distance other than 0, linked_vertices (they join vertices of one
-  /// mesh), a negative thickness. policy and cull_min_triangles select nothing without cones.
+  /// a culling other than Culling::None (cones cull self tests only), reuse_distance other than
+  /// 0, linked_vertices (they join vertices of one mesh), a negative thickness. policy and
+  /// cull_min_triangles select nothing without cones.
   PairDetector(std::vector<Face> faces_a, int num_vertices_a, const Positions& reference_a,
                std::vector<Face> faces_b, int num_vertices_b, const Positions& reference_b,
                const DetectOptions& options = {});
