@@ -3,10 +3,10 @@
 
 #include <gtest/gtest.h>
 
-#include "clothcd/research/detector.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
 #include "support/data.hpp"
 #include "support/detect_stats.hpp"
@@ -41,6 +41,8 @@ TEST(DetectEachData, ClothBallEqualsOneDetectPerConfiguration) {
     SCOPED_TRACE(to_string(build));
     DetectOptions base;
     base.build = build;
+    for (DetectOptions& c : configs)
+      c.build = build;  // the detector's build: another one is refused
     SelfDetector det(m0.faces, m0.num_vertices(), p0, base);
     const auto each = det.detect_each(p0, p1, configs);
     ASSERT_EQ(each.size(), configs.size());
