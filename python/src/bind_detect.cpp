@@ -7,9 +7,9 @@
 #include "bindings.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
-#include "clothcd/research/procedural.hpp"
 #include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd::python {
 namespace {
@@ -284,8 +284,9 @@ class PyPairDetector {
     o.build = parse_bvh_build(bvh, "bvh");
     args.apply(o);
     if (!(o.research == research::Options{})) {
-      fail("PairDetector: the research culling rules and cones serve self-collision culling only; "
-           "use culling 'none' and a policy between two meshes");
+      fail(
+          "PairDetector: the research culling rules and cones serve self-collision culling only; "
+          "use culling 'none' and a policy between two meshes");
     }
     // The detector numbers edges as a Topology of the same faces does.
     const Topology ta(fa, static_cast<int>(a.rows())), tb(fb, static_cast<int>(b.rows()));

@@ -16,8 +16,8 @@
 #include "clothcd/detect/names.hpp"
 #include "front.hpp"
 #include "narrow.hpp"
-#include "pair_results.hpp"
 #include "options.hpp"
+#include "pair_results.hpp"
 #include "positions.hpp"
 #include "traversal.hpp"
 

@@ -11,8 +11,8 @@
 #include <numbers>
 
 #include "clothcd/core/error.hpp"
-#include "clothcd/research/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "clothcd/sim/frame_io.hpp"
 #include "clothcd/sim/intersections.hpp"
 #include "clothcd/sim/scene.hpp"

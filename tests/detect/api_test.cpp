@@ -14,13 +14,13 @@
 #include <tuple>
 
 #include "api_scenes.hpp"
-#include "clothcd/research/detector.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/research/detector.hpp"
+#include "clothcd/research/names.hpp"
 #include "clothcd/research/oracle.hpp"
 #include "clothcd/research/procedural.hpp"
-#include "clothcd/research/names.hpp"
 #include "support/detect_stats.hpp"
 
 namespace clothcd {

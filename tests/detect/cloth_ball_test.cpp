@@ -6,9 +6,9 @@
 
 #include <set>
 
-#include "clothcd/research/detector.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/detector.hpp"
 #include "support/data.hpp"
 #include "support/json_file.hpp"
 

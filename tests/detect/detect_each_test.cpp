@@ -9,12 +9,12 @@
 #include <cstdint>
 #include <vector>
 
-#include "clothcd/research/detector.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
-#include "clothcd/research/procedural.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "support/detect_stats.hpp"
 
 namespace clothcd {

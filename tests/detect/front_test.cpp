@@ -15,8 +15,8 @@
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/bvh/traverse.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/research/procedural.hpp"
 #include "clothcd/mesh/topology.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "detect/front.hpp"
 
 namespace clothcd {

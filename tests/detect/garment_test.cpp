@@ -10,12 +10,12 @@
 #include <array>
 #include <cstdio>
 
-#include "clothcd/research/detector.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/research/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/sewing.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/options.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "support/data.hpp"
 
 namespace clothcd {

@@ -6,9 +6,9 @@
 #include <cctype>
 #include <string>
 
-#include "clothcd/research/detector.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/names.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
 
 namespace clothcd {

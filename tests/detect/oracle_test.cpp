@@ -6,11 +6,11 @@
 
 #include <tuple>
 
-#include "clothcd/research/detector.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/research/detector.hpp"
+#include "clothcd/research/names.hpp"
 #include "clothcd/research/oracle.hpp"
 #include "clothcd/research/procedural.hpp"
-#include "clothcd/research/names.hpp"
 
 namespace clothcd {
 // A namespace of its own: the research types below stay in this file of the unity build.

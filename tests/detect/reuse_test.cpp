@@ -12,9 +12,9 @@
 #include <random>
 
 #include "api_scenes.hpp"
-#include "clothcd/research/detector.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/procedural.hpp"
 
 namespace clothcd {

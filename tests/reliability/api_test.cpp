@@ -11,9 +11,9 @@
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "clothcd/mesh/topology.hpp"
 #include "clothcd/research/oracle.hpp"
 #include "clothcd/research/procedural.hpp"
-#include "clothcd/mesh/topology.hpp"
 
 namespace clothcd {
 namespace {

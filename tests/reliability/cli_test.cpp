@@ -15,10 +15,10 @@
 
 #include "cli_runner.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/research/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/triangle_mesh.hpp"
 #include "clothcd/research/detector.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd {
 namespace {
