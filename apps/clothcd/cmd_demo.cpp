@@ -21,9 +21,10 @@
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
-#include "clothcd/detect/procedural.hpp"
 #include "clothcd/geometry/cone.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "command.hpp"
 #include "misses.hpp"
 
@@ -270,10 +271,10 @@ int run_detection_demo(const DemoArgs& a) {
                     static_cast<std::size_t>(a.threads));
   }
   const ProceduralScene s = demo_scene(a);
-  DetectOptions o;
+  research::DetectOptions o;
   o.build = build;
   const auto t = std::chrono::steady_clock::now();
-  SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+  research::SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
   const double build_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   const Bvh& bvh = det.bvh();

@@ -19,10 +19,11 @@
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
-#include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/sewing.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "command.hpp"
 #include "misses.hpp"
 
@@ -32,6 +33,10 @@ namespace detect_command {
 
 namespace fs = std::filesystem;
 using namespace clothcd;
+// The research detector: the CLI offers the unsound rules, the optimal cones and --verify.
+using research::DetectOptions;
+using research::DetectResult;
+using research::SelfDetector;
 
 struct Args {
   std::string t0, t1, json;

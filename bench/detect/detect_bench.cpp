@@ -11,6 +11,7 @@
 
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
 
 namespace {
@@ -51,15 +52,15 @@ void BM_ClothBallStep(benchmark::State& state) {
     return;
   }
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 2);
-  DetectOptions o;
+  research::DetectOptions o;
   o.policy = static_cast<ConePolicy>(state.range(0));
   const auto culling = static_cast<research::CullingRule>(state.range(1));
   research::set_culling_rule(o, culling);
   o.build = static_cast<BvhBuild>(state.range(2));
   o.research.verify = true;
-  SelfDetector det(f->m0.faces, f->m0.num_vertices(), f->p0, o);
+  research::SelfDetector det(f->m0.faces, f->m0.num_vertices(), f->p0, o);
   // Check first: the sound mode misses nothing against the unculled traversal.
-  const DetectResult check = det.detect(f->p0, f->p1);
+  const research::DetectResult check = det.detect(f->p0, f->p1);
   const research::Verification& missed = check.verification;
   if (culling == research::CullingRule::Sound &&
       (!missed.missed_vf.empty() || !missed.missed_ee.empty())) {

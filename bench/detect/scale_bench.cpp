@@ -21,7 +21,7 @@
 #include <string>
 
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace {
 

@@ -16,9 +16,9 @@
 #include <utility>
 
 #include "clothcd/bvh/bvh.hpp"
-#include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/topology.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace {
 

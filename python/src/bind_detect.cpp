@@ -7,11 +7,18 @@
 #include "bindings.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd::python {
 namespace {
+
+// The research detector and options: the Python module offers the unsound rules, the optimal
+// cones and verify.
+using research::DetectOptions;
+using research::DetectResult;
+using research::SelfDetector;
 
 // The options shared by both detectors' constructors; all keyword-only in Python.
 struct OptionArgs {
@@ -24,7 +31,7 @@ struct OptionArgs {
   std::optional<bool> distance_filter;
 
   void apply(DetectOptions& o) const {
-    // Research names included ("cone", "gated", "optimal"): they set DetectOptions::research.
+    // Research names included ("cone", "gated", "optimal"): they set the research options.
     if (policy) research::set_cone_rule(o, research::parse_cone_rule(*policy, "policy"));
     if (culling) research::set_culling_rule(o, research::parse_culling_rule(*culling, "culling"));
     if (thickness) {
@@ -234,7 +241,7 @@ class PySelfDetector {
     workers_.run([&] { det_->set_active_faces(f); });
   }
   void clear_active() {
-    workers_.run([&] { det_->clear_active_faces(); });
+    workers_.run([&] { det_->clear_active(); });
   }
   void rebuild(const ArrayLike& V) {
     const PointsArg a(V, "V");
@@ -276,6 +283,11 @@ class PyPairDetector {
     DetectOptions o;
     o.build = parse_bvh_build(bvh, "bvh");
     args.apply(o);
+    if (!(o.research == research::Options{})) {
+      fail(
+          "PairDetector: the research culling rules and cones serve self-collision culling only; "
+          "use culling 'none' and a policy between two meshes");
+    }
     // The detector numbers edges as a Topology of the same faces does.
     const Topology ta(fa, static_cast<int>(a.rows())), tb(fb, static_cast<int>(b.rows()));
     edges_a_ = ta.edges();

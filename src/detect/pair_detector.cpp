@@ -13,10 +13,11 @@
 #include "ccd/distances.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
+#include "clothcd/detect/names.hpp"
 #include "front.hpp"
 #include "narrow.hpp"
 #include "options.hpp"
+#include "pair_results.hpp"
 #include "positions.hpp"
 #include "traversal.hpp"
 
@@ -30,20 +31,10 @@ double seconds_since(Clock::time_point t) {
 
 // Options the two-mesh detector cannot honour are refused before any work.
 void check_pair_options(const DetectOptions& o) {
-  if (o.culling != Culling::None || o.research.unsound_culling != research::UnsoundCulling::None) {
+  if (o.culling != Culling::None) {
     throw InputError(
         "PairDetector: normal cones cull self-collision tests only; use Culling::None between "
         "two meshes");
-  }
-  if (o.research.verify) {
-    throw InputError(
-        "PairDetector: verify compares culled and unculled self traversals; it has "
-        "nothing to verify between two meshes");
-  }
-  if (o.research.optimal_cones) {
-    throw InputError(
-        "PairDetector: optimal cones serve self-collision culling only; it computes no cones "
-        "between two meshes");
   }
   if (o.reuse_distance != 0.0) {
     throw InputError(fmt::format("PairDetector: reuse_distance is not supported (got {}); use 0",
@@ -139,40 +130,6 @@ struct Buffer {
   std::vector<VertexFaceCollision> ab, ba;
   std::vector<EdgeEdgeCollision> ee;
 };
-
-// CCD of vertex v of side `sv` against face f of side `sf`, with the context `k`'s settings.
-bool vf_hit(const detail::FeatureContext& k, const detail::FeatureContext& sv, int v,
-            const detail::FeatureContext& sf, int f, detail::FeatureCounters& c, double& toi) {
-  const Face& t = sf.topo->faces()[f];
-  const VertexFaceQuery q{sv.v0[v], sf.v0[t[0]], sf.v0[t[1]], sf.v0[t[2]],
-                          sv.v1[v], sf.v1[t[0]], sf.v1[t[1]], sf.v1[t[2]]};
-  return k.ccd_hit(q, c.vf_tests, c.vf_np, toi);
-}
-
-bool ee_hit(const detail::FeatureContext& ca, int ea, const detail::FeatureContext& cb, int eb,
-            detail::FeatureCounters& c, double& toi) {
-  const Edge& x = ca.topo->edges()[ea];
-  const Edge& y = cb.topo->edges()[eb];
-  const EdgeEdgeQuery q{ca.v0[x[0]], ca.v0[x[1]], cb.v0[y[0]], cb.v0[y[1]],
-                        ca.v1[x[0]], ca.v1[x[1]], cb.v1[y[0]], cb.v1[y[1]]};
-  return ca.ccd_hit(q, c.ee_tests, c.ee_np, toi);
-}
-
-PairDetectResult collect(tbb::enumerable_thread_specific<Buffer>& locals) {
-  PairDetectResult res;
-  for (const auto& l : locals) {
-    l.c.add_to(res.stats);
-    res.vf_a_on_b.insert(res.vf_a_on_b.end(), l.ab.begin(), l.ab.end());
-    res.vf_b_on_a.insert(res.vf_b_on_a.end(), l.ba.begin(), l.ba.end());
-    res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
-  }
-  std::sort(res.vf_a_on_b.begin(), res.vf_a_on_b.end(), detail::vf_less);
-  std::sort(res.vf_b_on_a.begin(), res.vf_b_on_a.end(), detail::vf_less);
-  std::sort(res.ee.begin(), res.ee.end(), detail::ee_less);
-  res.stats.vf_collisions = res.vf_a_on_b.size() + res.vf_b_on_a.size();
-  res.stats.ee_collisions = res.ee.size();
-  return res;
-}
 
 template <class Item>
 void sort_by_ids(std::vector<Item>& v) {
@@ -353,7 +310,7 @@ struct PairDetector::Impl {
       flush_ba(out);
       flush_ee(out);
     }
-    PairDetectResult res = collect(locals);
+    PairDetectResult res = detail::collect_pair_results(locals);
     res.stats.box_tests = st.box_tests;
     res.stats.front_pairs = st.front_pairs;
     res.stats.triangle_pairs = pairs.size();
@@ -524,9 +481,13 @@ const DetectOptions& PairDetector::options() const {
 }
 void PairDetector::set_options(const DetectOptions& options) {
   check_pair_options(options);
-  const BvhBuild build = impl_->opt.build;
+  if (options.build != impl_->opt.build) {
+    throw InputError(fmt::format(
+        "PairDetector::set_options: the BVH build is fixed at construction ({}), got {}; "
+        "construct a detector for another build",
+        to_string(impl_->opt.build), to_string(options.build)));
+  }
   impl_->opt = options;
-  impl_->opt.build = build;
   if (!options.reuse_front) impl_->front.clear();
 }
 const Topology& PairDetector::topology_a() const {
@@ -540,48 +501,6 @@ const Bvh& PairDetector::bvh_a() const {
 }
 const Bvh& PairDetector::bvh_b() const {
   return impl_->b.bvh;
-}
-
-PairDetectResult brute_force_detect_pair(const Topology& a, const Positions& a_t0,
-                                         const Positions& a_t1, const Topology& b,
-                                         const Positions& b_t0, const Positions& b_t1,
-                                         const DetectOptions& options) {
-  std::vector<Eigen::Vector3d> a0, a1, b0, b1;
-  detail::to_points(a_t0, a.num_vertices(), "mesh A at t0", a0);
-  detail::to_points(a_t1, a.num_vertices(), "mesh A at t1", a1);
-  detail::to_points(b_t0, b.num_vertices(), "mesh B at t0", b0);
-  detail::to_points(b_t1, b.num_vertices(), "mesh B at t1", b1);
-  const detail::FeatureContext ca = detail::ccd_context(a, a0, a1, options);
-  const detail::FeatureContext cb = detail::ccd_context(b, b0, b1, options);
-  tbb::enumerable_thread_specific<Buffer> locals;
-  // Every vertex against every face of the other mesh, every edge against every edge.
-  auto vertex_faces = [&](const detail::FeatureContext& sv, const detail::FeatureContext& sf,
-                          auto member) {
-    tbb::parallel_for(0, sv.topo->num_vertices(), [&](int v) {
-      if (sv.topo->vertex_faces(v).empty()) return;
-      Buffer& out = locals.local();
-      const detail::Box bv = sv.vertex_box(v);
-      for (int f = 0; f < sf.topo->num_faces(); ++f) {
-        double toi = 1.0;
-        if (detail::overlap(bv, sf.face_box(f)) && vf_hit(ca, sv, v, sf, f, out.c, toi)) {
-          (out.*member).push_back({v, f, sf.topo->faces()[f], toi});
-        }
-      }
-    });
-  };
-  vertex_faces(ca, cb, &Buffer::ab);
-  vertex_faces(cb, ca, &Buffer::ba);
-  tbb::parallel_for(0, a.num_edges(), [&](int ea) {
-    Buffer& out = locals.local();
-    const detail::Box xa = ca.edge_box(ea);
-    for (int eb = 0; eb < b.num_edges(); ++eb) {
-      double toi = 1.0;
-      if (detail::overlap(xa, cb.edge_box(eb)) && ee_hit(ca, ea, cb, eb, out.c, toi)) {
-        out.ee.push_back({ea, eb, a.edges()[ea], b.edges()[eb], toi});
-      }
-    }
-  });
-  return collect(locals);
 }
 
 }  // namespace clothcd

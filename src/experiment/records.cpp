@@ -14,6 +14,10 @@
 #include "clothcd/detect/names.hpp"
 
 namespace clothcd::experiment {
+
+// The research options: the unsound rules and the optimal cones.
+using research::DetectOptions;
+
 namespace {
 
 struct StepCol {

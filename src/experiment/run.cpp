@@ -18,9 +18,15 @@
 #include "clothcd/core/atomic_file.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/experiment/experiment.hpp"
+#include "clothcd/research/detector.hpp"
 #include "records.hpp"
 
 namespace clothcd::experiment {
+
+// The research options and detector: the unsound rules, optimal cones and detect_each.
+using research::DetectOptions;
+using research::SelfDetector;
+
 namespace {
 
 namespace fs = std::filesystem;

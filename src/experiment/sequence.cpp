@@ -11,8 +11,8 @@
 #include <numbers>
 
 #include "clothcd/core/error.hpp"
-#include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "clothcd/sim/frame_io.hpp"
 #include "clothcd/sim/intersections.hpp"
 #include "clothcd/sim/scene.hpp"
@@ -101,7 +101,7 @@ Positions to_positions(const std::vector<Eigen::Vector3d>& x) {
 Sequence one_step(const ProceduralScene& s) {
   Sequence q;
   q.name = s.name;
-  q.source = "procedural: " + s.name + " (clothcd/detect/procedural.hpp, one step)";
+  q.source = "procedural: " + s.name + " (clothcd/research/procedural.hpp, one step)";
   q.faces = s.faces;
   q.num_vertices = s.num_vertices;
   q.frames = {s.v_t0, s.v_t1};

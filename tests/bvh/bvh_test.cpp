@@ -12,7 +12,7 @@
 #include <set>
 
 #include "clothcd/bvh/bvh.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "support/random_gen.hpp"
 
 namespace clothcd {

@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "detect/traversal.hpp"
 
 // Helpers in a namespace of their own: the tests of a folder may share one translation unit.

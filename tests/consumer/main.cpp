@@ -2,6 +2,7 @@
 // step through clothcd::clothcd and one simulated frame through clothcd::simulator.
 #include <clothcd/cone.hpp>
 #include <clothcd/detect/detector.hpp>
+#include <clothcd/research/detector.hpp>
 #include <clothcd/research/names.hpp>
 #include <clothcd/sim/scene.hpp>
 #include <clothcd/sim/simulation.hpp>
@@ -21,15 +22,15 @@ int detect_step() {
       0.2, 0.01, 0.2, 0.3, 0.01, 0.2, 0.2, 0.01, 0.3;
   clothcd::Positions x1 = x0;
   x1.bottomRows(3).col(1).array() -= 0.02;
-  clothcd::DetectOptions options;
+  clothcd::research::DetectOptions options;
   options.culling = clothcd::Culling::Sound;
   // The research options by name: sound culling checked against unculled detection.
   options.research.verify = true;
   if (clothcd::research::culling_rule(options) != clothcd::research::parse_culling_rule("SOUND")) {
     return 1;
   }
-  clothcd::SelfDetector detector(faces, 6, x0, options);
-  const clothcd::DetectResult r = detector.detect(x0, x1);
+  clothcd::research::SelfDetector detector(faces, 6, x0, options);
+  const clothcd::research::DetectResult r = detector.detect(x0, x1);
   const clothcd::research::Verification& v = r.verification;
   std::printf("detect: %zu VF, %zu EE collisions, verified %d, missed %zu\n", r.vf.size(),
               r.ee.size(), int(v.ran), v.missed_vf.size() + v.missed_ee.size());

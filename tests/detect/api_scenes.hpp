@@ -5,11 +5,12 @@
 
 #include <cmath>
 #include <map>
+#include <span>
 #include <vector>
 
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
+#include "clothcd/research/oracle.hpp"
 
 namespace clothcd::test {
 
@@ -134,13 +135,22 @@ inline void check_pair_detector(double thickness) {
 }
 
 // Every VF pair (v not on f) and EE pair (no shared vertex) within h, by direct distance.
-inline ProximityResult brute_force_proximity(const Topology& t, const Positions& p, double h) {
+// `links`: DetectOptions::linked_vertices, whose pairs are left out (any order).
+inline ProximityResult brute_force_proximity(const Topology& t, const Positions& p, double h,
+                                             std::span<const std::pair<int, int>> links = {}) {
   auto pt = [&](int v) { return Eigen::Vector3d(p.row(v).transpose()); };
+  auto linked = [&](int u, int w) {
+    for (auto [a, b] : links) {
+      if ((a == u && b == w) || (a == w && b == u)) return true;
+    }
+    return false;
+  };
   ProximityResult r;
   for (int v = 0; v < t.num_vertices(); ++v) {
     for (int f = 0; f < t.num_faces(); ++f) {
       const Face& x = t.faces()[f];
       if (v == x[0] || v == x[1] || v == x[2]) continue;
+      if (linked(v, x[0]) || linked(v, x[1]) || linked(v, x[2])) continue;
       const double d = point_triangle_proximity(pt(v), pt(x[0]), pt(x[1]), pt(x[2])).distance;
       if (d <= h) r.vf.push_back({v, f, d});
     }
@@ -149,6 +159,10 @@ inline ProximityResult brute_force_proximity(const Topology& t, const Positions&
     for (int b = a + 1; b < t.num_edges(); ++b) {
       const Edge &ea = t.edges()[a], &eb = t.edges()[b];
       if (ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1]) continue;
+      if (linked(ea[0], eb[0]) || linked(ea[0], eb[1]) || linked(ea[1], eb[0]) ||
+          linked(ea[1], eb[1])) {
+        continue;
+      }
       const double d = edge_edge_proximity(pt(ea[0]), pt(ea[1]), pt(eb[0]), pt(eb[1])).distance;
       if (d <= h) r.ee.push_back({a, b, d});
     }

@@ -17,13 +17,19 @@
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
+#include "clothcd/research/oracle.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "support/detect_stats.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace api_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 using namespace clothcd::test;
 
@@ -75,7 +81,7 @@ void check_restricted(const ProceduralScene& s, const DetectResult& full, const 
       const DetectResult r = det.detect(s.v_t0, s.v_t1);
       EXPECT_EQ(r.vf, ref.vf);
       EXPECT_EQ(r.ee, ref.ee);
-      det.clear_active_faces();
+      det.clear_active();
       const DetectResult all = det.detect(s.v_t0, s.v_t1);
       EXPECT_EQ(all.vf, full.vf);
       EXPECT_EQ(all.ee, full.ee);
@@ -171,7 +177,7 @@ TEST(DetectApi, ReusedDetectorEqualsBruteForceOverASequenceOfCalls) {
           }
           det.set_active_vertices(active);
         } else {
-          det.clear_active_faces();
+          det.clear_active();
         }
         const DetectResult r = det.detect(x0, x1);
         const DetectResult all = brute_force_detect(topo, x0, x1);
@@ -373,5 +379,5 @@ TEST(DetectApi, LinkedVertexOutOfRangeIsAnInputError) {
   EXPECT_NO_THROW((void)det.detect(s.v_t0, s.v_t1));
 }
 
-}  // namespace
+}  // namespace api_test
 }  // namespace clothcd

@@ -17,7 +17,7 @@
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 
 // Helpers in a namespace of their own: the tests of a folder may share one translation unit.
 namespace clothcd::candidates_test {

@@ -8,11 +8,17 @@
 
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/detector.hpp"
 #include "support/data.hpp"
 #include "support/json_file.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace cloth_ball_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 struct GroundTruth {
   std::vector<std::pair<int, int>> vf;  // (vertex, face)
@@ -108,5 +114,5 @@ TEST(ClothBall, ReportsEveryGroundTruthCollision) {
   }
 }
 
-}  // namespace
+}  // namespace cloth_ball_test
 }  // namespace clothcd

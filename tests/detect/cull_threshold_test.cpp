@@ -10,7 +10,7 @@
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd::cull_threshold_test {
 namespace {

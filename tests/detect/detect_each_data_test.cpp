@@ -6,12 +6,18 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
 #include "support/data.hpp"
 #include "support/detect_stats.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace detect_each_data_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 TEST(DetectEachData, ClothBallEqualsOneDetectPerConfiguration) {
   CLOTHCD_REQUIRE_DATA(root, "cloth-ball");
@@ -35,6 +41,8 @@ TEST(DetectEachData, ClothBallEqualsOneDetectPerConfiguration) {
     SCOPED_TRACE(to_string(build));
     DetectOptions base;
     base.build = build;
+    for (DetectOptions& c : configs)
+      c.build = build;  // the detector's build: another one is refused
     SelfDetector det(m0.faces, m0.num_vertices(), p0, base);
     const auto each = det.detect_each(p0, p1, configs);
     ASSERT_EQ(each.size(), configs.size());
@@ -49,5 +57,5 @@ TEST(DetectEachData, ClothBallEqualsOneDetectPerConfiguration) {
   }
 }
 
-}  // namespace
+}  // namespace detect_each_data_test
 }  // namespace clothcd

@@ -12,12 +12,18 @@
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "support/detect_stats.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace detect_each_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 using research::ConeRule;
 using research::CullingRule;
@@ -71,7 +77,9 @@ TEST(DetectEach, EqualsOneDetectPerConfiguration) {
           DetectOptions base;
           base.build = build;
           SelfDetector det(s.faces, s.num_vertices, s.v_t0, base);
-          const auto configs = all_configs(thickness);
+          auto configs = all_configs(thickness);
+          for (DetectOptions& c : configs)
+            c.build = build;  // the detector's build: another one is refused
           const auto each = det.detect_each(s.v_t0, s.v_t1, configs);
           ASSERT_EQ(each.size(), configs.size());
           // The detector's own options are back.
@@ -149,16 +157,19 @@ TEST(DetectEach, RefusesConfigurationsThatShareNoNarrowPhase) {
   b = a;
   b.thickness = -1;
   refused({b});
+  b = a;
+  b.build = BvhBuild::Patch;  // the detector's tree is the spatial build
+  refused({b});
   refused(std::vector<DetectOptions>(65, a));
   const std::vector<int> active{0, 1};
   det.set_active_faces(active);
   refused({a});
-  det.clear_active_faces();
+  det.clear_active();
   EXPECT_TRUE(det.detect_each(s.v_t0, s.v_t1, std::vector<DetectOptions>{}).empty());
   // Positions of the wrong size are refused too, with the positions named.
   const Positions short_one = s.v_t0.topRows(3);
   EXPECT_THROW((void)det.detect_each(short_one, s.v_t1, std::vector<DetectOptions>{a}), InputError);
 }
 
-}  // namespace
+}  // namespace detect_each_test
 }  // namespace clothcd

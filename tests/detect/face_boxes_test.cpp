@@ -12,7 +12,7 @@
 #include <span>
 #include <vector>
 
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "detect/step_positions.hpp"
 #include "face_boxes_check.hpp"
 #include "support/random_gen.hpp"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "clothcd/core/error.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "detect/narrow.hpp"
 #include "detect/step_positions.hpp"
 #include "face_boxes_check.hpp"

@@ -15,8 +15,8 @@
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/bvh/traverse.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/topology.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "detect/front.hpp"
 
 namespace clothcd {
@@ -239,8 +239,8 @@ TEST(ReuseFront, DetectorResultsUnchanged) {
               ref.set_active_faces(some);
               expect_same_as_without_front(det.detect(x0, x1), ref.detect(x0, x1),
                                            what + " restricted");
-              det.clear_active_faces();
-              ref.clear_active_faces();
+              det.clear_active();
+              ref.clear_active();
             }
             if (k == 2) {
               const ProximityResult pa = det.proximity(x1, thickness);

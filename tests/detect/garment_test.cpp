@@ -11,14 +11,20 @@
 #include <cstdio>
 
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/sewing.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/options.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "support/data.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace garment_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 struct Garment {
   TriangleMesh sewn;
@@ -75,7 +81,7 @@ TEST(Garments, DressPatchConnectedAndSoundCullsHalfOfCone) {
       o.research = {};  // the cone rule of the previous policy off
       o.research.verify = true;
       det.set_options(o);
-      const DetectResult sound = det.detect(g.p0, g.p1);
+      const research::DetectResult sound = det.detect(g.p0, g.p1);
       ASSERT_TRUE(sound.verification.ran);
       EXPECT_TRUE(sound.verification.missed_vf.empty());
       EXPECT_TRUE(sound.verification.missed_ee.empty());
@@ -107,7 +113,7 @@ TEST(Garments, MultilayerPatchConnectedAndSoundExact) {
   o.culling = Culling::Sound;
   o.research.verify = true;
   SelfDetector det(g.sewn.faces, g.sewn.num_vertices(), g.p0, o);
-  const DetectResult r = det.detect(g.p0, g.p1);
+  const research::DetectResult r = det.detect(g.p0, g.p1);
   EXPECT_GE(r.stats.connected_share(), 0.99);
   const research::Verification& v = r.verification;
   ASSERT_TRUE(v.ran);
@@ -144,7 +150,7 @@ TEST(Garments, DressSoundWithThicknessAndReuseExact) {
     o.reuse_distance = reuse;
     o.research.verify = true;
     SelfDetector det(g.sewn.faces, g.sewn.num_vertices(), g.p0, o);
-    const DetectResult r = det.detect(g.p0, g.p1);
+    const research::DetectResult r = det.detect(g.p0, g.p1);
     ASSERT_TRUE(r.verification.ran);
     EXPECT_TRUE(r.verification.missed_vf.empty());
     EXPECT_TRUE(r.verification.missed_ee.empty());
@@ -185,7 +191,7 @@ TEST(Garments, DressCullThresholdSameResults) {
       c.policy = policy;
       c.cull_min_triangles = min;
       SelfDetector det(g.sewn.faces, g.sewn.num_vertices(), g.p0, c);
-      const DetectResult r = det.detect(g.p0, g.p1);
+      const research::DetectResult r = det.detect(g.p0, g.p1);
       EXPECT_EQ(r.vf, want.vf);
       EXPECT_EQ(r.ee, want.ee);
       culled[min > 0 ? 1 : 0] = r.stats.nodes_culled;
@@ -198,5 +204,5 @@ TEST(Garments, DressCullThresholdSameResults) {
   }
 }
 
-}  // namespace
+}  // namespace garment_test
 }  // namespace clothcd

@@ -8,10 +8,16 @@
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/names.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace names_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 std::string upper(std::string_view s) {
   std::string u(s);
@@ -121,5 +127,5 @@ TEST(ResearchNames, EveryRuleRoundTripsThroughNamesAndOptions) {
   }
 }
 
-}  // namespace
+}  // namespace names_test
 }  // namespace clothcd

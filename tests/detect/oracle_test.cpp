@@ -7,12 +7,18 @@
 #include <tuple>
 
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
+#include "clothcd/research/oracle.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace oracle_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 std::vector<std::pair<int, int>> vf_set(const std::vector<VertexFaceCollision>& c) {
   std::vector<std::pair<int, int>> s;
@@ -39,7 +45,7 @@ constexpr research::ConeRule kPolicies[] = {research::ConeRule::Provot,
                                             research::ConeRule::Optimal};
 constexpr BvhBuild kBuilds[] = {BvhBuild::Spatial, BvhBuild::Patch};
 
-DetectResult run(const ProceduralScene& s, DetectOptions o) {
+research::DetectResult run(const ProceduralScene& s, DetectOptions o) {
   SelfDetector d(s.faces, s.num_vertices, s.v_t0, o);
   return d.detect(s.v_t0, s.v_t1);
 }
@@ -56,7 +62,7 @@ TEST(DetectOracle, NoneAndSoundEqualBruteForce) {
           o.build = build;
           research::set_cone_rule(o, policy);
           o.culling = culling;
-          const DetectResult r = run(s, o);
+          const research::DetectResult r = run(s, o);
           SCOPED_TRACE(::testing::Message() << s.name << " build " << int(build) << " policy "
                                             << int(policy) << " culling " << int(culling));
           EXPECT_EQ(vf_set(r.vf), vf_set(ref.vf));
@@ -84,7 +90,7 @@ Misses misses(const ProceduralScene& s, research::CullingRule culling, research:
   research::set_cone_rule(o, policy);
   o.build = build;
   o.research.verify = true;
-  const DetectResult r = run(s, o);
+  const research::DetectResult r = run(s, o);
   const research::Verification& v = r.verification;
   EXPECT_TRUE(v.ran);
   o.culling = Culling::None;
@@ -105,12 +111,12 @@ TEST(DetectOracle, ResearchOptionsOverrideTheCullingAndVerifyListsTheMisses) {
   o.research.unsound_culling = research::UnsoundCulling::Gated;
   o.research.verify = true;
   EXPECT_EQ(research::culling_rule(o), research::CullingRule::Gated);
-  const DetectResult gated = run(s, o);
+  const research::DetectResult gated = run(s, o);
   ASSERT_TRUE(gated.verification.ran);
   EXPECT_GT(gated.verification.missed_vf.size() + gated.verification.missed_ee.size(), 0u);
   EXPECT_GT(gated.verification.unculled_triangle_pairs, gated.stats.triangle_pairs);
   o.research.unsound_culling = research::UnsoundCulling::None;
-  const DetectResult sound = run(s, o);
+  const research::DetectResult sound = run(s, o);
   ASSERT_TRUE(sound.verification.ran);
   EXPECT_TRUE(sound.verification.missed_vf.empty());
   EXPECT_TRUE(sound.verification.missed_ee.empty());
@@ -143,5 +149,5 @@ TEST(DetectOracle, GatedMissesWindingStripSoundDoesNot) {
   }
 }
 
-}  // namespace
+}  // namespace oracle_test
 }  // namespace clothcd

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "detect/narrow.hpp"
 #include "detect/orphans.hpp"
 #include "support/random_gen.hpp"

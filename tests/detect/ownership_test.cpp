@@ -7,7 +7,7 @@
 
 #include <vector>
 
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 #include "ownership_check.hpp"
 #include "support/random_gen.hpp"
 

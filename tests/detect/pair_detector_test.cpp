@@ -12,7 +12,7 @@
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
+#include "clothcd/research/oracle.hpp"
 
 namespace clothcd {
 namespace {
@@ -215,12 +215,6 @@ TEST(PairDetector, RefusesOptionsItCannotHonour) {
   o.culling = Culling::Sound;
   EXPECT_THROW(make(o), InputError);
   o = {};
-  o.research.verify = true;
-  EXPECT_THROW(make(o), InputError);
-  o = {};
-  o.research.optimal_cones = true;
-  EXPECT_THROW(make(o), InputError);
-  o = {};
   o.reuse_distance = 0.001;
   EXPECT_THROW(make(o), InputError);
   o = {};
@@ -231,8 +225,12 @@ TEST(PairDetector, RefusesOptionsItCannotHonour) {
   EXPECT_THROW(make(o), InputError);
   PairDetector det(s.a.faces, s.a.nv(), s.a.v0, s.b.faces, s.b.nv(), s.b.v0);
   o = {};
-  o.research.unsound_culling = research::UnsoundCulling::Cone;
+  o.culling = Culling::Sound;
   EXPECT_THROW(det.set_options(o), InputError);
+  o = {};
+  o.build = BvhBuild::Patch;  // built spatial: the build is fixed at construction
+  EXPECT_THROW(det.set_options(o), InputError);
+  EXPECT_EQ(det.options().build, BvhBuild::Spatial);
   EXPECT_THROW(det.set_active_vertices(std::vector<int>{s.a.nv()}), InputError);
   EXPECT_THROW((void)det.proximity(s.a.v0, s.b.v0, -1.0), InputError);
 }

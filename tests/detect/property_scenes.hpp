@@ -22,7 +22,7 @@
 
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
+#include "clothcd/research/oracle.hpp"
 
 namespace clothcd::test {
 

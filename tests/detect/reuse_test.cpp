@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -13,10 +14,16 @@
 #include "api_scenes.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/detector.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd {
-namespace {
+// A namespace of its own: the research types below stay in this file of the unity build.
+namespace reuse_test {
+
+// The research detector and options (unsound rules, optimal cones, verification).
+using research::DetectOptions;
+using research::SelfDetector;
 
 using namespace clothcd::test;
 
@@ -117,7 +124,7 @@ TEST(ProximityReuse, KeptAcrossRestrictedPasses) {
       }
       det.set_active_vertices(active);
       static_cast<void>(det.detect(s.v_t0, later));
-      det.clear_active_faces();
+      det.clear_active();
       const ProximityResult r = det.proximity(later, kKept);
       EXPECT_GT(r.reused_pairs, 0u);
       expect_same(r, brute_force_proximity(topo, later, kKept));
@@ -183,14 +190,14 @@ TEST(ProximityReuse, OffWhereItCannotHold) {
     expect_same(r, ref);
   }
   {
-    SCOPED_TRACE("the unsound cone rule may cull close pairs");
-    DetectOptions cone = o;
-    cone.research.unsound_culling = research::UnsoundCulling::Cone;
-    SelfDetector det(s.faces, s.num_vertices, s.v_t0, cone);
-    static_cast<void>(det.detect(s.v_t0, end));
-    const ProximityResult r = det.proximity(end, kKept);
-    EXPECT_EQ(r.reused_pairs, 0u);
-    expect_same(r, ref);
+    SCOPED_TRACE("the unsound rules may cull close pairs: refused with a reuse distance");
+    for (auto rule : {research::UnsoundCulling::Cone, research::UnsoundCulling::Gated}) {
+      DetectOptions cone = o;
+      cone.research.unsound_culling = rule;
+      EXPECT_THROW(SelfDetector(s.faces, s.num_vertices, s.v_t0, cone), InputError);
+      SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+      EXPECT_THROW(det.set_options(cone), InputError);
+    }
   }
   {
     SCOPED_TRACE("a query under an active restriction keeps its scope");
@@ -245,6 +252,105 @@ TEST(ProximityReuse, SoundCullingKeepsWhatTheQueryNeeds) {
   EXPECT_GT(reused, 0u);
 }
 
+// Linked vertices (DetectOptions::linked_vertices) join no reported pair in proximity(), as in
+// detect(): the query equals the all-pairs distance oracle less the linked pairs, with and
+// without the reuse of a detection's pairs (none moved, a few moved), and with an active
+// restriction on top.
+TEST(ProximityLinks, LeavesLinkedPairsOut) {
+  std::size_t restricted_found = 0;  // pairs of the restricted queries, over all scenes
+  for (const auto& s : reuse_scenes()) {
+    SCOPED_TRACE(s.name);
+    const Topology topo(s.faces, s.num_vertices);
+    const Positions end = 0.5 * (s.v_t0 + s.v_t1);
+    // Link a vertex of every other close pair to its partner feature's first vertex, so that the
+    // links remove pairs the query would report otherwise (and more pairs on those vertices).
+    const ProximityResult all = brute_force_proximity(topo, end, kKept);
+    std::vector<std::pair<int, int>> links;
+    for (std::size_t i = 0; i < all.vf.size(); i += 2)
+      links.emplace_back(topo.faces()[all.vf[i].face][0], all.vf[i].vertex);
+    for (std::size_t i = 0; i < all.ee.size(); i += 2)
+      links.emplace_back(topo.edges()[all.ee[i].edge_a][1], topo.edges()[all.ee[i].edge_b][0]);
+    ASSERT_FALSE(links.empty());
+    // The queries' positions: those of the detection, and a few vertices moved since.
+    struct At {
+      Positions v;
+      ProximityResult ref;  // the oracle less the linked pairs
+    };
+    std::vector<At> ats;
+    for (double share : {0.0, 0.1}) {
+      At a{moved(end, share, 0.01, 11), {}};
+      a.ref = brute_force_proximity(topo, a.v, kKept, links);
+      const ProximityResult unlinked = brute_force_proximity(topo, a.v, kKept);
+      EXPECT_LT(a.ref.vf.size() + a.ref.ee.size(), unlinked.vf.size() + unlinked.ee.size());
+      ats.push_back(std::move(a));
+    }
+    auto linked = [&](int u, int w) {
+      return std::count(links.begin(), links.end(), std::pair(u, w)) +
+                 std::count(links.begin(), links.end(), std::pair(w, u)) >
+             0;
+    };
+    for (double reuse : {0.0, kKept}) {
+      for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
+        SCOPED_TRACE(::testing::Message() << "reuse " << reuse << " build " << int(build));
+        DetectOptions o;
+        o.build = build;
+        o.reuse_distance = reuse;
+        o.linked_vertices = links;
+        SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+        for (const At& a : ats) {
+          const DetectResult d = det.detect(s.v_t0, end);
+          const ProximityResult r = det.proximity(a.v, kKept);
+          expect_same(r, a.ref);
+          EXPECT_EQ(r.reused_pairs > 0, reuse > 0);
+          for (const auto& c : d.vf) {  // detect() leaves the same pairs out
+            for (int x : c.face_vertices)
+              EXPECT_FALSE(linked(x, c.vertex));
+          }
+        }
+        // Under an active restriction: the restricted query's pairs less the linked ones.
+        std::vector<int> active;
+        for (int v = 0; v < s.num_vertices; v += 3)
+          active.push_back(v);
+        DetectOptions plain = o;
+        plain.linked_vertices.clear();
+        SelfDetector unlinked(s.faces, s.num_vertices, s.v_t0, plain);
+        det.set_active_vertices(active);
+        unlinked.set_active_vertices(active);
+        const ProximityResult r = det.proximity(ats[0].v, kKept);
+        ProximityResult ref = unlinked.proximity(ats[0].v, kKept);
+        std::erase_if(ref.vf, [&](const auto& p) {
+          const Face& t = topo.faces()[p.face];
+          return linked(p.vertex, t[0]) || linked(p.vertex, t[1]) || linked(p.vertex, t[2]);
+        });
+        std::erase_if(ref.ee, [&](const auto& p) {
+          const Edge &a = topo.edges()[p.edge_a], &b = topo.edges()[p.edge_b];
+          return linked(a[0], b[0]) || linked(a[0], b[1]) || linked(a[1], b[0]) ||
+                 linked(a[1], b[1]);
+        });
+        restricted_found += ref.vf.size() + ref.ee.size();
+        expect_same(r, ref);
+        det.clear_active();
+      }
+    }
+  }
+  EXPECT_GT(restricted_found, 0u);
+}
+
+// The BVH build is fixed at construction: set_options with another one is refused, the same
+// build accepted.
+TEST(SetOptions, RefusesAnotherBuild) {
+  const ProceduralScene s = crumpled_sheet(4, 1);
+  DetectOptions o;
+  o.build = BvhBuild::Patch;
+  SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+  o.culling = Culling::Sound;
+  EXPECT_NO_THROW(det.set_options(o));
+  o.build = BvhBuild::Spatial;
+  EXPECT_THROW(det.set_options(o), InputError);
+  EXPECT_EQ(det.options().build, BvhBuild::Patch);
+  EXPECT_EQ(det.options().culling, Culling::Sound);
+}
+
 TEST(ProximityReuse, RejectsBadDistances) {
   const ProceduralScene s = crumpled_sheet(4, 1);
   for (double d :
@@ -257,5 +363,5 @@ TEST(ProximityReuse, RejectsBadDistances) {
   }
 }
 
-}  // namespace
+}  // namespace reuse_test
 }  // namespace clothcd

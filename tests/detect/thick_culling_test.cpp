@@ -9,8 +9,8 @@
 #include <numbers>
 
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/oracle.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd {
 namespace {

@@ -16,9 +16,9 @@
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
 #include "clothcd/experiment/experiment.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/oracle.hpp"
 #include "support/files.hpp"
 
 namespace {

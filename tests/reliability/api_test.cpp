@@ -11,9 +11,9 @@
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/oracle.hpp"
-#include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/topology.hpp"
+#include "clothcd/research/oracle.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd {
 namespace {

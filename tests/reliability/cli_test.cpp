@@ -15,10 +15,10 @@
 
 #include "cli_runner.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "clothcd/detect/procedural.hpp"
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/triangle_mesh.hpp"
-#include "clothcd/research/options.hpp"
+#include "clothcd/research/detector.hpp"
+#include "clothcd/research/procedural.hpp"
 
 namespace clothcd {
 namespace {
@@ -178,11 +178,11 @@ TEST(CliDetect, JsonHoldsTheDetectorsCollisionsExactly) {
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(CliScratch::slurp(dir / "out.json"));
   const TriangleMesh m0 = read_mesh(dir / "t0.obj"), m1 = read_mesh(dir / "t1.obj");
-  DetectOptions o;
+  research::DetectOptions o;
   o.research.unsound_culling = research::UnsoundCulling::Cone;
   o.research.verify = true;
-  SelfDetector det(m0.faces, m0.num_vertices(), vertices_matrix(m0), o);
-  const DetectResult want = det.detect(vertices_matrix(m0), vertices_matrix(m1));
+  research::SelfDetector det(m0.faces, m0.num_vertices(), vertices_matrix(m0), o);
+  const research::DetectResult want = det.detect(vertices_matrix(m0), vertices_matrix(m1));
   ASSERT_GT(want.vf.size() + want.ee.size(), 0u) << "no collisions to compare";
   const auto vf_json = [](const std::vector<VertexFaceCollision>& list) {
     nlohmann::json out = nlohmann::json::array();

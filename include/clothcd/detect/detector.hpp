@@ -13,6 +13,10 @@
 #include "clothcd/detect/types.hpp"
 
 namespace clothcd {
+namespace detail {
+struct SelfCore;
+struct SelfAccess;
+}  // namespace detail
 
 /// n x 3 vertex positions, one row per vertex.
 ///
@@ -78,17 +82,24 @@ class SelfDetector {
   [[nodiscard]] DetectResult detect(std::span<const Eigen::Vector3d> v_t0,
                                     std::span<const Eigen::Vector3d> v_t1);
 
-  /// VF and EE pairs closer than h at positions v (box culling only). After a detect() with
-  /// DetectOptions::reuse_distance >= h, it starts from that call's pairs (the same results).
+  /// VF and EE pairs closer than h at positions v (box culling only), less the pairs that
+  /// DetectOptions::linked_vertices join (as detect() leaves them out), within the active
+  /// restriction like detect(). After a detect() with DetectOptions::reuse_distance >= h, it
+  /// starts from that call's pairs (the same results).
   [[nodiscard]] ProximityResult proximity(const Positions& v, double h);
   [[nodiscard]] ProximityResult proximity(std::span<const Eigen::Vector3d> v, double h);
 
-  /// Restricts detection to pairs in which at least one feature belongs to an active triangle.
+  /// The active restriction, which detect() and proximity() honour until clear_active() (or a
+  /// rebuild()). A call of either setter replaces the restriction the other set.
+  /// set_active_faces: pairs in which at least one feature belongs to an active triangle.
   void set_active_faces(std::span<const int> faces);
-  /// Restricts detection to pairs in which at least one vertex is active: exactly the pairs whose
+  /// set_active_vertices: pairs in which at least one vertex is active, exactly the pairs whose
   /// motion changes when only the active vertices move (a simulator's passes after the first).
   void set_active_vertices(std::span<const int> vertices);
-  void clear_active_faces();
+  /// Lifts the active restriction, whichever setter made it.
+  void clear_active();
+  /// The same as clear_active().
+  void clear_active_faces() { clear_active(); }
 
   /// Builds the BVH afresh, split on `reference` (the same build kind). The tree is refit at
   /// every call but keeps the splits of the shape it was built on; once the mesh has deformed
@@ -98,32 +109,17 @@ class SelfDetector {
   void rebuild(const Positions& reference);
   void rebuild(std::span<const Eigen::Vector3d> reference);
 
-  /// The step v_t0 -> v_t1 under each of several options, for measuring culling rules and cone
-  /// policies against each other (the experiment's counting pass). Result k holds what
-  /// set_options(configs[k]) followed by detect() reports: the same collisions and the same
-  /// counters of DetectStats. The work differs: every configuration refits its cones and walks
-  /// its culling rule over the nodes, but the node pairs' box tests and the narrow phase run
-  /// once, over the pairs that some configuration keeps, each pair's results counted for the
-  /// configurations that keep it. time_refit is each configuration's own refit; time_traverse
-  /// and time_narrow are NaN (shared work; detect() measures them). The configurations may
-  /// differ only in policy, culling, cull_min_triangles and the research options'
-  /// unsound_culling and optimal_cones (their build is ignored, as set_options ignores it);
-  /// reuse_distance must be 0, verify off, at most 64 of them and no active restriction.
-  /// Throws InputError otherwise. The detector's own options are left as they were.
-  [[nodiscard]] std::vector<DetectResult> detect_each(const Positions& v_t0, const Positions& v_t1,
-                                                      std::span<const DetectOptions> configs);
-  [[nodiscard]] std::vector<DetectResult> detect_each(std::span<const Eigen::Vector3d> v_t0,
-                                                      std::span<const Eigen::Vector3d> v_t1,
-                                                      std::span<const DetectOptions> configs);
-
   [[nodiscard]] const DetectOptions& options() const;
-  void set_options(const DetectOptions& options);  ///< the BVH build stays as constructed
+  /// Replaces the options for the following calls. The BVH build is fixed at construction: an
+  /// options.build other than options().build throws InputError (rebuild() keeps the build; a
+  /// new detector takes another). Throws InputError as the constructor does.
+  void set_options(const DetectOptions& options);
   [[nodiscard]] const Topology& topology() const;
   [[nodiscard]] const Bvh& bvh() const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  friend struct detail::SelfAccess;
+  std::unique_ptr<detail::SelfCore> impl_;
 };
 
 /// Collisions between two meshes A (e.g. a garment) and B (e.g. a body); no self-collisions.
@@ -149,9 +145,9 @@ class PairDetector {
  public:
   /// Builds both topologies and box-only BVHs (split on the references). Throws InputError on
   /// bad faces, a reference of the wrong size, or options it cannot honour between two meshes:
-  /// a culling other than Culling::None (cones cull self tests only), research options other than
-  /// their defaults, reuse_distance other than 0, linked_vertices (they join vertices of one
-  /// mesh), a negative thickness.
+  /// a culling other than Culling::None (cones cull self tests only), reuse_distance other than
+  /// 0, linked_vertices (they join vertices of one mesh), a negative thickness. policy and
+  /// cull_min_triangles select nothing without cones.
   PairDetector(std::vector<Face> faces_a, int num_vertices_a, const Positions& reference_a,
                std::vector<Face> faces_b, int num_vertices_b, const Positions& reference_b,
                const DetectOptions& options = {});
@@ -183,10 +179,11 @@ class PairDetector {
   [[nodiscard]] PairProximityResult proximity(std::span<const Eigen::Vector3d> a,
                                               std::span<const Eigen::Vector3d> b, double h);
 
-  /// Restricts detection to pairs with an active vertex (ids of A and of B): a VF pair when its
-  /// vertex or a vertex of its face is active, an EE pair when an endpoint is active. Throws
-  /// InputError for an id out of range.
+  /// Restricts detect() and proximity() to pairs with an active vertex (ids of A and of B), until
+  /// clear_active() (or a rebuild()): a VF pair when its vertex or a vertex of its face is active,
+  /// an EE pair when an endpoint is active. Throws InputError for an id out of range.
   void set_active_vertices(std::span<const int> vertices_a, std::span<const int> vertices_b = {});
+  /// Lifts the active restriction.
   void clear_active();
 
   /// Builds both BVHs afresh, split on the references (see SelfDetector::rebuild: results do not
@@ -197,7 +194,8 @@ class PairDetector {
                std::span<const Eigen::Vector3d> reference_b);
 
   [[nodiscard]] const DetectOptions& options() const;
-  /// Throws InputError like the constructor; the BVH build stays as constructed.
+  /// Throws InputError like the constructor, and for an options.build other than
+  /// options().build (the build is fixed at construction, as for SelfDetector::set_options).
   void set_options(const DetectOptions& options);
   [[nodiscard]] const Topology& topology_a() const;
   [[nodiscard]] const Topology& topology_b() const;

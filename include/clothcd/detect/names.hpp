@@ -8,8 +8,7 @@
 ///   BvhBuild:   spatial, patch
 ///
 /// Names are lower case; parsing ignores case, so the paper's PROVOT and PROPOSED are accepted.
-/// The research settings (the unsound rules cone and gated, the optimal cones) have their names in
-/// clothcd/research/names.hpp.
+/// The research module's settings (clothcd/research/names.hpp) extend these names.
 
 #include <string_view>
 

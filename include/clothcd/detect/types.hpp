@@ -9,7 +9,6 @@
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/detect/collisions.hpp"
 #include "clothcd/mesh/topology.hpp"
-#include "clothcd/research/options.hpp"
 
 namespace clothcd {
 
@@ -56,11 +55,10 @@ struct DetectOptions {
   /// Bisections of the distance filter (`distance_filter_culls` depth) when thickness > 0: each
   /// level can cull near misses the whole-step bound cannot, before the costlier kernel runs.
   int distance_filter_depth = 0;
-  /// A simulator's shortcut, results unchanged: when > 0 (with Culling::None or Sound), an
-  /// unrestricted detect() widens its candidate boxes to at least this distance and keeps its
-  /// triangle pairs, so that a following proximity(v, h) with h <= reuse_distance traverses only
-  /// near the vertices whose position in v differs from theirs at t1 (all of them when over a
-  /// quarter do).
+  /// A simulator's shortcut, results unchanged: when > 0, an unrestricted detect() widens its
+  /// candidate boxes to at least this distance and keeps its triangle pairs, so that a following
+  /// proximity(v, h) with h <= reuse_distance traverses only near the vertices whose position in v
+  /// differs from theirs at t1 (all of them when over a quarter do).
   double reuse_distance = 0.0;
   /// Culling::Sound tests only nodes of at least this many triangles, and the refit computes
   /// cones for those only (RefitOptions::cone_min_triangles). A test on a smaller node can save
@@ -80,9 +78,6 @@ struct DetectOptions {
   /// pairs joining them are not tested, like pairs that share a vertex. Any order; duplicates
   /// allowed.
   std::vector<std::pair<int, int>> linked_vertices;
-  /// For measuring the paper's rules; a simulator leaves it at its default (see
-  /// clothcd/research/options.hpp: unsound culling rules, optimal cones, verification).
-  research::Options research;
   bool operator==(const DetectOptions&) const = default;
 };
 
@@ -125,8 +120,6 @@ struct DetectResult {
   std::vector<VertexFaceCollision> vf;  ///< sorted by (vertex, face)
   std::vector<EdgeEdgeCollision> ee;    ///< sorted by (edge_a, edge_b)
   DetectStats stats;
-  /// What the unculled detection found and this one missed (DetectOptions::research.verify).
-  research::Verification verification;
 };
 
 }  // namespace clothcd

@@ -56,7 +56,7 @@ void drop_frames_before(Sequence& seq, int first);
 /// the fold carries self-collisions, some between disconnected layers.
 [[nodiscard]] Sequence folding_sheet(int n = 16, int steps = 6);
 
-/// The single-step scenes of clothcd/detect/procedural.hpp as one-step sequences, by name:
+/// The single-step scenes of clothcd/research/procedural.hpp as one-step sequences, by name:
 /// stacked_sheets, winding_strip, crumpled_sheet, twisted_strip; and `fold` (folding_sheet with
 /// n = 40 and 12 steps). Throws InputError for another name.
 [[nodiscard]] Sequence procedural_sequence(const std::string& name);

@@ -8,18 +8,14 @@
 ///   ConeRule:    provot, proposed, exact, optimal
 ///
 /// Parsing ignores case, so the paper's PROVOT and PROPOSED are accepted. A simulator needs only
-/// clothcd/detect/names.hpp, whose names are those of DetectOptions.
+/// clothcd/detect/names.hpp, whose names are those of clothcd::DetectOptions. The functions below
+/// read and set research::DetectOptions (the product's options and research::Options).
 
 #include <string_view>
 
-#include "clothcd/detect/types.hpp"
+#include "clothcd/research/options.hpp"
 
 namespace clothcd::research {
-
-/// Culling::None and Sound, and the unsound rules of UnsoundCulling.
-enum class CullingRule { None, Cone, Gated, Sound };
-/// ConePolicy's three policies, and the optimal reference cones (Options::optimal_cones).
-enum class ConeRule { Provot, Proposed, Exact, Optimal };
 
 /// The rule a detector with these options runs: research.unsound_culling when set, else culling.
 [[nodiscard]] CullingRule culling_rule(const DetectOptions& options);

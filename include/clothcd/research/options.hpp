@@ -1,19 +1,25 @@
 #pragma once
 /// @file
-/// Research options of the self detector (DetectOptions::research): settings that reproduce the
-/// paper's measurements (Han, Lee, Lee and Ko, Eurographics 2021) and check a culling rule
-/// against unculled detection. A simulator leaves them at their defaults: the unsound rules can
-/// miss collisions, and the other options cost time without changing what Culling::None and
-/// Culling::Sound report.
+/// Research options of the self detector (research::DetectOptions, taken by research::SelfDetector
+/// in clothcd/research/detector.hpp): settings that reproduce the paper's measurements (Han, Lee,
+/// Lee and Ko, Eurographics 2021) and check a culling rule against unculled detection. A simulator
+/// uses clothcd::SelfDetector instead: the unsound rules can miss collisions, and the other
+/// options cost time without changing what Culling::None and Culling::Sound report.
 /// clothcd/research/names.hpp names every setting, research ones included, as the command-line
 /// tool, the Python module and the experiment spell them.
 
 #include <cstdint>
 #include <vector>
 
-#include "clothcd/detect/collisions.hpp"
+#include "clothcd/detect/types.hpp"
 
 namespace clothcd::research {
+
+/// Every culling rule the measurements compare, as one value: Culling::None and Sound, and the
+/// unsound rules of UnsoundCulling (set_culling_rule in clothcd/research/names.hpp).
+enum class CullingRule { None, Cone, Gated, Sound };
+/// ConePolicy's three policies, and the optimal reference cones (Options::optimal_cones).
+enum class ConeRule { Provot, Proposed, Exact, Optimal };
 
 /// Culling rules that can miss collisions (docs/detect.md): for measuring how much the paper's
 /// rule culls and what it misses against Culling::Sound, which finds all that Culling::None finds.
@@ -23,11 +29,12 @@ enum class UnsoundCulling {
           ///< Misses contacts between parts of a node that face the same way without touching
           ///< along an edge (two stacked sheets) and within a patch that winds over itself
   Gated,  ///< the cone rule on edge-connected nodes only. Still misses contacts: a connected
-          ///< patch can wind over itself (winding_strip in clothcd/detect/procedural.hpp)
+          ///< patch can wind over itself (winding_strip in clothcd/research/procedural.hpp)
 };
 
 struct Options {
-  /// Overrides DetectOptions::culling when not None (the detector then runs this rule).
+  /// Overrides DetectOptions::culling when not None (the detector then runs this rule). Refused
+  /// with a reuse distance: an unsound rule may cull the pairs it keeps.
   UnsoundCulling unsound_culling = UnsoundCulling::None;
   /// Optimal node cones (the minimal cone of every descendant triangle's normal control
   /// directions, from exact leaf caps) instead of DetectOptions::policy's merges: the reference
@@ -42,7 +49,7 @@ struct Options {
   bool operator==(const Options&) const = default;
 };
 
-/// What Options::verify found (DetectResult::verification).
+/// What Options::verify found (research::DetectResult::verification).
 struct Verification {
   bool ran = false;  ///< verify was set and a culling rule ran; otherwise the rest is empty
   /// Collisions the unculled detection reports and the culled one does not, sorted like
@@ -50,6 +57,19 @@ struct Verification {
   std::vector<VertexFaceCollision> missed_vf;
   std::vector<EdgeEdgeCollision> missed_ee;
   std::uint64_t unculled_triangle_pairs = 0;  ///< triangle pairs of the unculled traversal
+};
+
+/// The product's options and the research ones.
+struct DetectOptions : clothcd::DetectOptions {
+  DetectOptions() = default;
+  DetectOptions(const clothcd::DetectOptions& o) : clothcd::DetectOptions(o) {}  // NOLINT: implicit
+  Options research;
+  bool operator==(const DetectOptions&) const = default;
+};
+
+/// A detection's results, and what Options::verify found.
+struct DetectResult : clothcd::DetectResult {
+  Verification verification;
 };
 
 }  // namespace clothcd::research

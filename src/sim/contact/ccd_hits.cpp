@@ -63,13 +63,14 @@ double CcdHits::separation(double d0, double sep_scale) const {
   return sep_scale * std::min(opt_.ccd_thickness, 0.5 * d0);
 }
 
-// Dropped pairs (seam-linked, or an escaping vertex's body pairs) are dropped; tangled pairs and
-// pairs touching at t0 are excluded (left to repulsion); a pair farther apart at t0 (d0()) than
-// `reach` (what both sides move plus the separation) cannot touch; a resting pair, closer at t0
-// than twice the CCD separation, is retested at its own separation (see separation()); the rest
-// become contacts at the detector's time of impact. The response needs the first contact only
-// roughly (impulses use the geometry at toi), so the retest's kernel, like the detector's, stops
-// refining it at `toi_tolerance` (on the early side).
+// Dropped pairs (an escaping vertex's body pairs; the detector leaves seam-linked ones out) are
+// dropped; tangled pairs and pairs touching at t0 are excluded (left to repulsion); a pair
+// farther apart at t0 (d0()) than `reach` (what both sides move plus the separation) cannot
+// touch; a resting pair, closer at t0 than twice the CCD separation, is retested at its own
+// separation (see separation()); the rest become contacts at the detector's time of impact. The
+// response needs the first contact only roughly (impulses use the geometry at toi), so the
+// retest's kernel, like the detector's, stops refining it at `toi_tolerance` (on the early
+// side).
 template <class Query, class Distance, class Make>
 CcdHits::Hit CcdHits::settle(double sep_scale, bool dropped, bool tangled, double toi,
                              const Query& query, Distance&& d0, Make&& make, double reach) const {
@@ -129,8 +130,7 @@ void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
     const VertexFaceQuery query{x0[q], x0[t[0]], x0[t[1]], x0[t[2]],
                                 x1[q], x1[t[0]], x1[t[1]], x1[t[2]]};
     return settle(
-        sep_scale, g_.vf_linked(q, p.face), crossings_.vf_tangled(g_.cloth(), q, p.face), p.toi,
-        query,
+        sep_scale, false, crossings_.vf_tangled(g_.cloth(), q, p.face), p.toi, query,
         [&] { return point_triangle_proximity(x0[q], x0[t[0]], x0[t[1]], x0[t[2]]).distance; },
         [&](Contact& c, double toi) { return g_.make_vf(c, q, false, p.face, false, toi, v); },
         kNoReach);
@@ -142,8 +142,7 @@ void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
     const EdgeEdgeQuery query{x0[a[0]], x0[a[1]], x0[b[0]], x0[b[1]],
                               x1[a[0]], x1[a[1]], x1[b[0]], x1[b[1]]};
     return settle(
-        sep_scale, g_.ee_linked(p.edge_a, p.edge_b),
-        crossings_.ee_tangled(g_.cloth(), p.edge_a, p.edge_b), p.toi, query,
+        sep_scale, false, crossings_.ee_tangled(g_.cloth(), p.edge_a, p.edge_b), p.toi, query,
         [&] { return edge_edge_proximity(x0[a[0]], x0[a[1]], x0[b[0]], x0[b[1]]).distance; },
         [&](Contact& c, double toi) {
           return g_.make_ee(c, p.edge_a, false, p.edge_b, false, toi, v);

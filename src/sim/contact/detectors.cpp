@@ -51,7 +51,7 @@ void ContactDetectors::start_body(const SubstepContext& ctx, ContactGeometry& g)
 
 ProximityResult ContactDetectors::self_proximity(const ContactGeometry& g, double d) {
   // Unrestricted, which also lets the query reuse the last full CCD pass's pairs.
-  self_->clear_active_faces();
+  self_->clear_active();
   return self_->proximity(g.x0, d);
 }
 
@@ -60,7 +60,7 @@ DetectResult ContactDetectors::self_ccd(const ContactGeometry& g, std::span<cons
   if (active != nullptr) {
     self_->set_active_vertices(*active);
   } else {
-    self_->clear_active_faces();
+    self_->clear_active();
   }
   DetectResult r = self_->detect(g.x0, x1);
   // The first full pass after a build measures the tree's fit.

@@ -13,7 +13,7 @@ bool normalize(Vec3& n) {
 }
 
 ContactGeometry::ContactGeometry(const ClothModel& model)
-    : model_(model), links_(model.num_vertices(), model.seam_links()) {}
+    : model_(model) {}
 
 void ContactGeometry::start(const SubstepContext& ctx) {
   x0 = ctx.x0;
@@ -28,14 +28,6 @@ void ContactGeometry::start_response(bool with_body) {
   if (!with_body) return;
   for (std::size_t i = 0; i < b0.size(); ++i)
     vb[i] = (b1[i] - b0[i]) / h;
-}
-
-bool ContactGeometry::vf_linked(int v, int f) const {
-  const std::array<int, 1> a{v};
-  return links_.any_linked(a, cloth().faces()[f]);
-}
-bool ContactGeometry::ee_linked(int a, int b) const {
-  return links_.any_linked(cloth().edges()[a], cloth().edges()[b]);
 }
 
 const Vec3& ContactGeometry::position(const Contact& c, int k, double tau, std::span<const Vec3> v,

@@ -9,7 +9,6 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/sim/cloth_model.hpp"
 #include "clothcd/sim/collision.hpp"
-#include "sim/seam_links.hpp"
 
 namespace clothcd::sim::detail {
 
@@ -44,10 +43,6 @@ class ContactGeometry {
   [[nodiscard]] const Topology& body() const { return *body_; }
   [[nodiscard]] const ClothModel& model() const { return model_; }
 
-  // Seam-linked pairs (the seam's two sides count as one point).
-  [[nodiscard]] bool vf_linked(int v, int f) const;
-  [[nodiscard]] bool ee_linked(int a, int b) const;
-
   [[nodiscard]] const Vec3& position(const Contact& c, int k, double tau, std::span<const Vec3> v,
                                      Vec3& tmp) const;
   [[nodiscard]] Vec3 velocity(const Contact& c, int k, std::span<const Vec3> v) const {
@@ -78,7 +73,6 @@ class ContactGeometry {
 
   const ClothModel& model_;
   const Topology* body_ = nullptr;
-  SeamLinks links_;
 };
 
 }  // namespace clothcd::sim::detail

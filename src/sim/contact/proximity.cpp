@@ -25,12 +25,10 @@ SelfProximityFigures ProximityContacts::find(ContactDetectors& detectors, const 
     f.reused_pairs += static_cast<long long>(r.reused_pairs);
     f.pairs += static_cast<long long>(r.vf.size() + r.ee.size());
     for (const auto& p : r.vf) {
-      if (g_.vf_linked(p.vertex, p.face)) continue;
       Contact c;
       if (g_.make_vf(c, p.vertex, false, p.face, false, 0.0, none)) add_proximity(c);
     }
     for (const auto& p : r.ee) {
-      if (g_.ee_linked(p.edge_a, p.edge_b)) continue;
       Contact c;
       if (g_.make_ee(c, p.edge_a, false, p.edge_b, false, 0.0, none)) add_proximity(c);
     }

@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// Small procedural scenes with one linear motion each, built so that the motion produces
-/// collisions that the culling modes treat differently (docs/detect.md):
+/// The research module's test scenes: small procedural meshes with one linear motion each, built
+/// so that the motion produces collisions that the culling modes treat differently
+/// (docs/detect.md):
 /// - stacked sheets: two disconnected sheets with parallel normals pass through each other; the
 ///   paper's cone-only rule culls the pair, the connectivity gate does not;
 /// - winding strip: a connected strip that winds more than once around an axis with all its

@@ -1,4 +1,4 @@
-#include "clothcd/detect/procedural.hpp"
+#include "clothcd/research/procedural.hpp"
 
 #include <Eigen/Geometry>
 

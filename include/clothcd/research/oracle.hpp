@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// Brute-force reference for the detector: every VF and EE feature pair of the mesh, each put
-/// through the same feature box test, NP filter and kernel as the detector. Quadratic: tests only.
+/// Brute-force references of the detectors (the research module's oracle): every VF and EE
+/// feature pair of the mesh (or meshes), each put through the same feature box test, filters and
+/// kernel as the detectors. Quadratic: for tests and measurements only.
 
 #include "clothcd/detect/detector.hpp"
 
