@@ -12,8 +12,7 @@ bool normalize(Vec3& n) {
   return true;
 }
 
-ContactGeometry::ContactGeometry(const ClothModel& model)
-    : model_(model) {}
+ContactGeometry::ContactGeometry(const ClothModel& model) : model_(model) {}
 
 void ContactGeometry::start(const SubstepContext& ctx) {
   x0 = ctx.x0;
