@@ -7,7 +7,9 @@ the collision stage, substeps per frame, intersecting pairs (frame 0, worst fram
 and unresolved / excluded CCD hits. With --parts, a second table says where the collision stage's
 time went (the manifest's collision_parts, summed over frames; runs that predate them are
 skipped), and a third splits the self detector's part: its full CCD passes' phases and its
-proximity query.
+proximity query. A strain table follows when the manifests have the per-frame `strain` figures:
+the worst frame's median, p99, p99.9 and largest strain, where the largest sat (the count of
+frames per site), and the limiter's share of the time.
 """
 import json
 import statistics
@@ -94,6 +96,31 @@ def self_row(folder: Path) -> str | None:
     )
 
 
+SITES = ["seam", "sliver", "body_contact", "elsewhere"]
+
+
+def strain_row(folder: Path) -> str | None:
+    m = json.loads((folder / "manifest.json").read_text())
+    frames = [f for f in m["frames"] if "strain" in f]
+    if not frames:
+        return None
+    st = [f["strain"] for f in frames]
+
+    def worst(key: str) -> str:
+        i = max(range(len(st)), key=lambda k: st[k][key])
+        return f"{100 * st[i][key]:.1f}% ({frames[i]['frame']})"
+
+    sites = {s: sum(1 for x in st if x["max_site"] == s) for s in SITES}
+    limit = m.get("strain_limit", {})
+    secs = sum(f["seconds"] for f in frames)
+    share = sum(f.get("strain_limit", {}).get("seconds", 0.0) for f in frames) / secs if secs else 0
+    return (
+        f"| {m['scene']} | {limit.get('stretch', '')} | {len(frames)} | "
+        f"{100 * max(x['median'] for x in st):.2f}% | {worst('p99')} | {worst('p999')} | "
+        f"{worst('max')} | " + " / ".join(str(sites[s]) for s in SITES) + f" | {100 * share:.1f}% |"
+    )
+
+
 def main() -> int:
     args = sys.argv[1:]
     parts = "--parts" in args
@@ -111,6 +138,15 @@ def main() -> int:
         except (OSError, KeyError, ValueError) as e:
             print(f"{d}: cannot read manifest.json: {e}", file=sys.stderr)
             return 1
+    strain = [r for r in (strain_row(Path(d)) for d in args) if r is not None]
+    if strain:
+        print()
+        print("| scene | strain limit | frames | largest median | worst p99 (frame) | "
+              "worst p99.9 (frame) | largest (frame) | frames whose largest sits at seam / "
+              "sliver / body contact / elsewhere | limiter time share |")
+        print("|---|---|---:|---:|---:|---:|---:|---|---:|")
+        for r in strain:
+            print(r)
     if parts:
         print()
         print("| scene | frames | collision ms / substep | "

@@ -104,6 +104,7 @@ struct ContactHandler::Impl {
       PartClock clock(times.response_s);
       std::fill(touched.begin(), touched.end(), 0);
       projection.project(hs, v, touched);
+      if (ctx.after_projection) ctx.after_projection(v, touched);
       active = detail::flagged(touched);
     }
     // 3. Impact zones for the hits the passes left.

@@ -39,7 +39,7 @@ struct PinnedVertex {
 }  // namespace
 
 struct ClothSolver::Impl {
-  explicit Impl(const ClothModel& m) : assembler(m), h(assembler.make_matrix()) {}
+  explicit Impl(const ClothModel& m) : assembler(m), h(assembler.make_matrix()), limiter(m) {}
   SystemAssembler assembler;
   BlockCsr h;
   Vecs gradient, hv, b;
@@ -51,6 +51,9 @@ struct ClothSolver::Impl {
   std::vector<ContactConstraint> constraints;
   CouplingTerms couplings;
   std::optional<CoarseSpace> coarse;
+  StrainLimiter limiter;
+  std::vector<Vec3> support;  // per vertex: the body contact's normal while held, else zero
+  std::vector<std::uint8_t> body_contact;  // vertices of the last accepted substep's constraints
 
   Vec3 pin_target(const PinnedVertex& p, double t) const {
     const PinGroup& g = groups[p.group];
@@ -222,6 +225,44 @@ bool ClothSolver::try_step(ClothState& state, double h, double tolerance, StepSt
 
   Vecs v_star(n);
   for_each_vertex(n, [&](int i) { v_star[i] = state.v[i] + dv[i]; });
+  // Strain limiting on the end positions, before the collision stage: its CCD passes see the
+  // limited motion, so the frames stay crossing-free (docs/simulator.md 2.2).
+  if (im.limiter.enabled()) {
+    const auto start = std::chrono::steady_clock::now();
+    im.support.assign(im.constraints.empty() ? 0 : n, Vec3::Zero());
+    for (const ContactConstraint& cc : im.constraints) {
+      if (im.filter.kind[cc.vertex] == VertexFilter::Plane) im.support[cc.vertex] = cc.n;
+    }
+    const StrainLimitStats ls =
+        im.limiter.apply(state.x, h, im.inverse_mass, im.support, v_star, options_.strain_sweeps);
+    stats.strain.sweeps += ls.sweeps;
+    stats.strain.projections += ls.projections;
+    stats.strain.residual = std::max(stats.strain.residual, ls.residual);
+    stats.strain_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  // Again after the first CCD passes' projections, which stop single vertices while their
+  // neighbours move on; the next pass tests what the limiter moved.
+  if (handler_ != nullptr && im.limiter.enabled() && options_.strain_ccd_passes > 0) {
+    ctx.after_projection = [&, calls = 0](std::span<Vec3> v,
+                                          std::span<std::uint8_t> touched) mutable {
+      if (++calls > options_.strain_ccd_passes) return;
+      const auto t0 = std::chrono::steady_clock::now();
+      // The first call checks every triangle (repulsion and friction changed velocities
+      // everywhere), later ones only around what the last projection changed.
+      std::span<const std::uint8_t> start;
+      if (calls > 1) start = touched;
+      const StrainLimitStats ls = im.limiter.apply(state.x, h, im.inverse_mass, im.support, v,
+                                                   options_.strain_ccd_sweeps, start);
+      stats.strain.sweeps += ls.sweeps;
+      stats.strain.projections += ls.projections;
+      const auto moved = im.limiter.moved();
+      for (int i = 0; i < n; ++i)
+        touched[i] |= moved[i];
+      stats.strain_seconds +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+  }
   if (handler_ != nullptr) {
     const auto start = std::chrono::steady_clock::now();
     CollisionStats cs = handler_->respond(ctx, v_star);
@@ -238,6 +279,9 @@ bool ClothSolver::try_step(ClothState& state, double h, double tolerance, StepSt
   });
   state.dv = std::move(dv);
   state.time += h;
+  im.body_contact.assign(n, 0);
+  for (const ContactConstraint& cc : im.constraints)
+    im.body_contact[cc.vertex] = 1;
   return true;
 }
 
@@ -270,6 +314,10 @@ double ClothSolver::kinetic_energy(const std::vector<Vec3>& v) const {
   for (int i = 0; i < model_.num_vertices(); ++i)
     e += 0.5 * model_.mass()[i] * v[i].squaredNorm();
   return e;
+}
+
+const std::vector<std::uint8_t>& ClothSolver::body_contact() const {
+  return impl_->body_contact;
 }
 
 double ClothSolver::max_stretch(const std::vector<Vec3>& x) const {

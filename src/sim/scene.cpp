@@ -329,6 +329,12 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     mat.sliver_area_ratio = m.number("sliver_area_ratio", mat.sliver_area_ratio, 0.0, 1.0);
     mat.sliver_min_angle_deg =
         m.number("sliver_min_angle_deg", mat.sliver_min_angle_deg, 0.0, 60.0);
+    mat.strain_limit = m.number("strain_limit", mat.strain_limit, 0.0, 100.0);
+    if (mat.strain_limit != 0.0 && mat.strain_limit < 1.0) {
+      m.fail(m.key("strain_limit"),
+             fmt::format("expected 0 (off) or at least 1, got {}", mat.strain_limit));
+    }
+    mat.compression_limit = m.number("compression_limit", mat.compression_limit, 0.0, 1.0);
     m.finish();
   }
   if (top.has("solver")) {
@@ -346,6 +352,11 @@ Scene parse_scene(const json& j, const std::filesystem::path& file) {
     s.solver.halve_residual = o.number("halve_residual", s.solver.halve_residual, 0.0, INFINITY);
     s.solver.max_halvings = o.integer("max_halvings", s.solver.max_halvings, 0, 10);
     s.solver.halve_unresolved = o.boolean("halve_unresolved", s.solver.halve_unresolved);
+    s.solver.strain_sweeps = o.integer("strain_sweeps", s.solver.strain_sweeps, 1, 10000);
+    s.solver.strain_ccd_passes =
+        o.integer("strain_ccd_passes", s.solver.strain_ccd_passes, 0, 1000);
+    s.solver.strain_ccd_sweeps =
+        o.integer("strain_ccd_sweeps", s.solver.strain_ccd_sweeps, 1, 10000);
     // A solve that may stop above halve_residual would have every substep halved.
     for (const auto& [k, tolerance] :
          {std::pair{"pcg_tolerance", s.solver.pcg_tolerance},

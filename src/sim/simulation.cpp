@@ -73,6 +73,10 @@ FrameStats Simulation::advance_frame() {
     fs.halvings += st.halvings;
     fs.pcg_converged = fs.pcg_converged && st.converged;
     fs.collision += st.collision;
+    fs.strain_limit.sweeps += st.strain.sweeps;
+    fs.strain_limit.projections += st.strain.projections;
+    fs.strain_limit.residual = std::max(fs.strain_limit.residual, st.strain.residual);
+    fs.strain_seconds += st.strain_seconds;
   }
   if (contact_) {
     fs.self_ccd = contact_->take_self_ccd_figures();
@@ -84,6 +88,7 @@ FrameStats Simulation::advance_frame() {
   fs.frame = frame_;
   fs.time = t1;
   fs.max_stretch = solver_->max_stretch(state_.x);
+  fs.strain = strain_figures(*model_, state_.x, solver_->body_contact());
   for (const Vec3& x : state_.x)
     fs.finite = fs.finite && x.allFinite();
   for (const Vec3& v : state_.v)

@@ -25,6 +25,10 @@ struct ClothMaterial {
   double cot_clamp = 10.0;            ///< |cot| bound of the bending weights on slivers
   double sliver_area_ratio = 1e-3;    ///< membrane skipped below this fraction of the median area
   double sliver_min_angle_deg = 5.0;  ///< ... or below this minimum angle
+  /// Largest principal stretch the limiter allows (cotton's 1.06); 0: no stretch limit.
+  double strain_limit = 1.06;
+  /// Smallest principal stretch the limiter allows; 0: no compression limit.
+  double compression_limit = 0.0;
 };
 
 /// Vertex a tied to (1 - r) x_b + r x_c (stage.obj's `stitch a b c r`, 0-based).

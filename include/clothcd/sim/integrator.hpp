@@ -4,11 +4,13 @@
 /// docs/simulator.md 2.1): (M + h(h+beta)H) dv = h(f_ext - grad U(x_n) - (h+beta) H v_n),
 /// v* = v_n + dv, x_{n+1} = x_n + h v*. Results are bitwise identical for any thread count.
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "clothcd/sim/cloth_model.hpp"
 #include "clothcd/sim/collision.hpp"
+#include "clothcd/sim/strain.hpp"
 
 namespace clothcd::sim {
 
@@ -57,6 +59,13 @@ struct SolverOptions {
   /// Also halve a substep whose collision response leaves CCD hits unresolved (the impact
   /// zones gave up): a shorter substep asks of each zone a motion closer to its anchors'.
   bool halve_unresolved = true;
+  /// Strain limiter (ClothMaterial::strain_limit): Gauss-Seidel sweeps on the solve's result at
+  /// most; after how many of a substep's first CCD passes' projections it runs again; its sweeps
+  /// there at most (each call continues where the last stopped). Later passes run without it,
+  /// so that CCD settles the motion.
+  int strain_sweeps = 20;
+  int strain_ccd_passes = 6;
+  int strain_ccd_sweeps = 4;
 };
 
 struct StepStats {
@@ -67,6 +76,8 @@ struct StepStats {
   bool converged = true;       ///< every solve reached its tolerance
   double pcg_tolerance = 0.0;  ///< the tolerance the solves aimed at
   double max_stretch = 0.0;    ///< largest membrane stretch at the substeps' start states
+  StrainLimitStats strain;     ///< the limiter's passes, summed (residual: the largest)
+  double strain_seconds = 0.0;
   CollisionStats collision;
 };
 
@@ -103,6 +114,8 @@ class ClothSolver {
   [[nodiscard]] double kinetic_energy(const std::vector<Vec3>& v) const;
   /// Largest membrane stretch (sigma_max(F) - 1) at x.
   [[nodiscard]] double max_stretch(const std::vector<Vec3>& x) const;
+  /// One flag per vertex: held by a body contact constraint in the last substep.
+  [[nodiscard]] const std::vector<std::uint8_t>& body_contact() const;
 
   [[nodiscard]] const ClothModel& model() const { return model_; }
 

@@ -25,7 +25,10 @@ struct FrameStats {
   /// (more substeps than SubstepRule::min), pcg_tolerance otherwise.
   double pcg_tolerance = 0.0;
   double seconds = 0.0;
-  double max_stretch = 0.0;  ///< at the end of the frame
+  double max_stretch = 0.0;       ///< at the end of the frame (membrane triangles)
+  StrainFigures strain;           ///< every triangle at the end of the frame
+  StrainLimitStats strain_limit;  ///< the limiter over the frame's substeps
+  double strain_seconds = 0.0;    ///< the limiter's wall time
   double body_displacement = 0.0;
   bool finite = true;
   /// The collision stage, summed over the frame's substeps (zero without collisions); its

@@ -1,0 +1,154 @@
+#!/usr/bin/python3
+"""Strain of the frames of a `clothcd simulate` folder, measured from its mesh files alone.
+
+Usage: scripts/frame_strain.py [--first N] [--last N] [--json OUT] DIR [DIR ...]
+
+Strain is a triangle's largest principal stretch against its rest shape, minus 1 (the manifest's
+`strain`). The rest shape comes from the scene the folder's manifest names: the `vt` pattern of
+`cloth.pattern` for `"rest": "pattern"`, else the cloth's initial OBJ shape. Every triangle with a
+non-degenerate rest shape counts, slivers included; quantiles are nearest rank, as the simulator's.
+Prints one markdown row per folder with the range of the per-frame median, p90, p99, p99.9,
+largest strain and share over 10%, over the frames first..last (all by default); --json writes
+the per-frame figures. Runs of any version can be measured, so figures of runs made before the
+manifest had them are comparable with those after.
+"""
+import json
+import math
+import os
+import sys
+from pathlib import Path
+
+
+def data_path(text: str, scene_file: Path) -> Path:
+    root = os.environ.get("CLOTHCD_DATA") or str(scene_file.resolve().parent.parent / ".." / "shared" / "data")
+    p = Path(text.replace("${CLOTHCD_DATA}", root))
+    return p if p.is_absolute() else scene_file.parent / p
+
+
+def read_obj(path: Path, want_vt: bool = False):
+    v, vt, faces, face_vt = [], [], [], []
+    with open(path) as f:
+        for line in f:
+            if line.startswith("v "):
+                _, x, y, z = line.split()[:4]
+                v.append((float(x), float(y), float(z)))
+            elif want_vt and line.startswith("vt "):
+                p = line.split()
+                vt.append((float(p[1]), float(p[2])))
+            elif line.startswith("f "):
+                idx = [t.split("/") for t in line.split()[1:4]]
+                faces.append(tuple(int(t[0]) - 1 for t in idx))
+                if want_vt:
+                    face_vt.append(tuple(int(t[1]) - 1 if len(t) > 1 and t[1] else -1 for t in idx))
+    return v, vt, faces, face_vt
+
+
+def rest_grams(scene_file: Path):
+    """Faces of the cloth and each face's rest Gram matrix (r11, r12, r22), or None if degenerate."""
+    scene = json.loads(scene_file.read_text())
+    cloth = scene["cloth"]
+    v, _, faces, _ = read_obj(data_path(cloth["obj"], scene_file))
+    nv = cloth.get("vertices", len(v))
+    faces = [f for f in faces if max(f) < nv][: cloth.get("faces", len(faces))]
+    if cloth.get("rest", "initial") == "pattern":
+        _, vt, pfaces, pvt = read_obj(data_path(cloth["pattern"], scene_file), want_vt=True)
+        rest = [None] * nv
+        for f, t in zip(pfaces, pvt):
+            for a, b in zip(f, t):
+                rest[a] = (vt[b][0], vt[b][1], 0.0)
+    else:
+        rest = v[:nv]
+    grams = []
+    for a, b, c in faces:
+        e1 = [rest[b][k] - rest[a][k] for k in range(3)]
+        e2 = [rest[c][k] - rest[a][k] for k in range(3)]
+        r11 = sum(x * x for x in e1)
+        r12 = sum(x * y for x, y in zip(e1, e2))
+        r22 = sum(x * x for x in e2)
+        det = r11 * r22 - r12 * r12
+        grams.append((r11, r12, r22, det) if det > 0.0 and math.isfinite(det) else None)
+    return faces, grams
+
+
+def strains(x, faces, grams):
+    out = []
+    for (a, b, c), g in zip(faces, grams):
+        if g is None:
+            continue
+        xa, xb, xc = x[a], x[b], x[c]
+        e1 = (xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2])
+        e2 = (xc[0] - xa[0], xc[1] - xa[1], xc[2] - xa[2])
+        g11 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]
+        g12 = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2]
+        g22 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]
+        r11, r12, r22, rdet = g
+        # Eigenvalues of R^-1 G (the squared principal stretches): det(G - l R) = 0.
+        tr = (g11 * r22 + g22 * r11 - 2.0 * g12 * r12) / rdet
+        det = (g11 * g22 - g12 * g12) / rdet
+        half = 0.5 * tr
+        out.append(math.sqrt(max(0.0, half + math.sqrt(max(0.0, half * half - det)))) - 1.0)
+    return out
+
+
+def quantile(sorted_values, q):
+    k = max(1, math.ceil(q * len(sorted_values)))
+    return sorted_values[min(k, len(sorted_values)) - 1]
+
+
+def figures(s):
+    s = sorted(s)
+    over = sum(1 for x in s if x > 0.1)
+    return {"median": quantile(s, 0.5), "p90": quantile(s, 0.9), "p99": quantile(s, 0.99),
+            "p999": quantile(s, 0.999), "max": s[-1], "over_10": over / len(s)}
+
+
+def measure(folder: Path, first: int, last: int):
+    m = json.loads((folder / "manifest.json").read_text())
+    faces, grams = rest_grams(Path(m["scene_file"]))
+    ext = m.get("mesh_format", "obj")
+    if ext != "obj":
+        raise SystemExit(f"{folder}: only OBJ frames are read, this run wrote {ext}")
+    frames = {}
+    for k in range(first, min(last, m["complete_frames"]) + 1):
+        x, _, _, _ = read_obj(folder / f"frame_{k:04d}.obj")
+        frames[k] = figures(strains(x, faces, grams))
+    return m["scene"], frames
+
+
+def span(values, scale=100.0):
+    return f"{scale * min(values):.1f}-{scale * max(values):.1f}%"
+
+
+def main(argv):
+    first, last, out, folders = 1, 10**9, None, []
+    it = iter(argv)
+    for a in it:
+        if a == "--first":
+            first = int(next(it))
+        elif a == "--last":
+            last = int(next(it))
+        elif a == "--json":
+            out = Path(next(it))
+        else:
+            folders.append(Path(a))
+    if not folders:
+        print(__doc__, file=sys.stderr)
+        return 2
+    print("| run | frames | median | p90 | p99 | p99.9 | max per frame | over 10% |")
+    print("|---|---|---|---|---|---|---|---|")
+    dump = {}
+    for folder in folders:
+        scene, frames = measure(folder, first, last)
+        dump[str(folder)] = frames
+        if not frames:
+            continue
+        f = list(frames.values())
+        cells = [span([x[k] for x in f]) for k in ("median", "p90", "p99", "p999", "max", "over_10")]
+        print(f"| {scene} | {min(frames)}-{max(frames)} | " + " | ".join(cells) + " |")
+    if out:
+        out.write_text(json.dumps(dump, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
