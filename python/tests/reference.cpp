@@ -18,6 +18,7 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
 #include "clothcd/mesh/io.hpp"
+#include "clothcd/research/detector.hpp"
 #include "clothcd/research/names.hpp"
 #include "clothcd/research/oracle.hpp"
 #include "clothcd/research/procedural.hpp"
@@ -35,8 +36,8 @@ int get_int(const Args& a, const std::string& key, int fallback) {
   return std::stoi(get(a, key, std::to_string(fallback)));
 }
 
-DetectOptions options(const Args& a) {
-  DetectOptions o;
+research::DetectOptions options(const Args& a) {
+  research::DetectOptions o;
   research::set_cone_rule(o, research::parse_cone_rule(get(a, "policy", "proposed"), "policy"));
   research::set_culling_rule(o,
                              research::parse_culling_rule(get(a, "culling", "sound"), "culling"));
@@ -82,17 +83,17 @@ nlohmann::json pairs_json(const DetectResult& r) {
 }
 
 int run(const Args& a) {
-  const DetectOptions o = options(a);
+  const research::DetectOptions o = options(a);
   const int threads = get_int(a, "threads", 0);
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   return arena.execute([&] {
     if (a.count("scene") != 0) {
       const ProceduralScene s = scene(a);
-      SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
+      research::SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
       nlohmann::json j = pairs_json(det.detect(s.v_t0, s.v_t1));
       if (get(a, "oracle", "0") == "1") {
         const Topology topo(s.faces, s.num_vertices);
-        DetectOptions oo = o;
+        clothcd::DetectOptions oo = o;
         oo.culling = Culling::None;
         j["oracle"] = pairs_json(brute_force_detect(topo, s.v_t0, s.v_t1, oo));
       }
@@ -101,7 +102,7 @@ int run(const Args& a) {
     }
     const TriangleMesh m0 = read_mesh(get(a, "t0", "")), m1 = read_mesh(get(a, "t1", ""));
     const Positions p0 = vertices_matrix(m0), p1 = vertices_matrix(m1);
-    SelfDetector det(m0.faces, m0.num_vertices(), p0, o);
+    research::SelfDetector det(m0.faces, m0.num_vertices(), p0, o);
     const int runs = get_int(a, "runs", 0);
     if (runs <= 0) {
       std::cout << pairs_json(det.detect(p0, p1)).dump() << '\n';
