@@ -113,7 +113,7 @@ def strain_row(folder: Path) -> str | None:
     sites = {s: sum(1 for x in st if x["max_site"] == s) for s in SITES}
     limit = m.get("strain_limit", {})
     secs = sum(f["seconds"] for f in frames)
-    share = sum(f.get("strain_limit", {}).get("seconds", 0.0) for f in frames) / secs if secs else 0
+    share = sum(f.get("strain_seconds", 0.0) for f in frames) / secs if secs else 0
     return (
         f"| {m['scene']} | {limit.get('stretch', '')} | {len(frames)} | "
         f"{100 * max(x['median'] for x in st):.2f}% | {worst('p99')} | {worst('p999')} | "

@@ -59,8 +59,8 @@ std::string state_file(int k) {
 // which a resumed run starts afresh.
 nlohmann::json without_times(nlohmann::json j) {
   for (auto& f : j["frames"]) {
-    for (const char* k : {"seconds", "collision_seconds", "intersection_seconds", "self_ccd",
-                          "self_proximity", "collision_parts"})
+    for (const char* k : {"seconds", "collision_seconds", "intersection_seconds", "strain_seconds",
+                          "self_ccd", "self_proximity", "collision_parts"})
       f.erase(k);
   }
   return j;
