@@ -98,8 +98,6 @@ class SelfDetector {
   void set_active_vertices(std::span<const int> vertices);
   /// Lifts the active restriction, whichever setter made it.
   void clear_active();
-  /// The same as clear_active().
-  void clear_active_faces() { clear_active(); }
 
   /// Builds the BVH afresh, split on `reference` (the same build kind). The tree is refit at
   /// every call but keeps the splits of the shape it was built on; once the mesh has deformed
