@@ -101,17 +101,24 @@ EarliestImpact SelfCore::earliest_impact(PointsIn p0, PointsIn p1, const Earlies
   // A window's settings replace the detector's for its detection only: its contact distance and
   // time tolerance, and nothing kept for later calls (pairs for reuse, the traversal's front).
   const DetectOptions saved = opt;
+  const Rule saved_rule = cull;
   struct Restore {
     SelfCore& core;
     const DetectOptions& saved;
-    ~Restore() { core.opt = saved; }
-  } restore{*this, saved};
+    Rule rule;
+    ~Restore() {
+      core.opt = saved;
+      core.cull = rule;
+    }
+  } restore{*this, saved, saved_rule};
   return search_windows(
       first, rounding_slack(x0, x1), search, [&](double t, double slack, DetectStats& stats) {
         opt = saved;
+        // A short window's boxes are small: cones would cost a refit of their own and cull
+        // little, so its traversal tests boxes only.
+        cull = t < 1 ? Rule::None : saved_rule;
         opt.thickness = saved.thickness + slack;
-        // A window's hits need no time (the step's kernels give it), the
-        // step's the coarse one.
+        // A window's hits need no time (the step's kernels give it), the step's the coarse one.
         opt.toi_tolerance = t < 1 ? 1.0 : search.kernel().toi_tolerance;
         opt.reuse_distance = 0;
         opt.reuse_front = false;

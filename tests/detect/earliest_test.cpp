@@ -137,7 +137,7 @@ void expect_matches(const EarliestImpact& e, const EarliestImpact& ref, double t
 TEST(EarliestImpact, RandomScenesMatchBruteForceAndTheExactOracle) {
   const double tol = 1e-6;
   int hits = 0;
-  for (std::uint64_t seed = 1; seed <= 16; ++seed) {
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
     const RandomScene s = test::random_scene(seed);
     for (const double h : {0.0, 1e-3 * s.scale}) {
       DetectOptions o;
@@ -152,7 +152,7 @@ TEST(EarliestImpact, RandomScenesMatchBruteForceAndTheExactOracle) {
         const EarliestImpact e = det.earliest_impact(s.v0, s.v1, eo);
         expect_matches(e, ref, tol, what + " window " + std::to_string(window));
         // The exact oracle (slow) on the automatic window's answer.
-        if (h == 0 && window == 0 && seed <= 6) {
+        if (h == 0 && window == 0 && seed <= 4) {
           expect_no_contact_before(det.topology(), s.v0, s.v1, e.toi);
         }
         EXPECT_GE(e.windows, 1);
@@ -161,7 +161,7 @@ TEST(EarliestImpact, RandomScenesMatchBruteForceAndTheExactOracle) {
       hits += ref.kind != Kind::None;
     }
   }
-  EXPECT_GT(hits, 16);  // the scenes do collide
+  EXPECT_GT(hits, 12);  // the scenes do collide
 }
 
 TEST(EarliestImpact, SameAnswerForEveryThreadCount) {
