@@ -89,6 +89,7 @@ DetectResult SelfCore::detect(PointsIn p0, PointsIn p1) {
   st.time_traverse = seconds_since(t);
   t = Clock::now();
   FeatureContext ctx = ccd_context();
+  ctx.filters_only = window_filters_only;
   boxes.update(ctx, step);
   const bool keep = keeps() && !restricted;
   std::vector<std::uint8_t> near;

@@ -109,6 +109,7 @@ EarliestImpact SelfCore::earliest_impact(PointsIn p0, PointsIn p1, const Earlies
     ~Restore() {
       core.opt = saved;
       core.cull = rule;
+      core.window_filters_only = false;
     }
   } restore{*this, saved, saved_rule};
   return search_windows(
@@ -118,8 +119,10 @@ EarliestImpact SelfCore::earliest_impact(PointsIn p0, PointsIn p1, const Earlies
         // little, so its traversal tests boxes only.
         cull = t < 1 ? Rule::None : saved_rule;
         opt.thickness = saved.thickness + slack;
-        // A window's hits need no time (the step's kernels give it), the step's the coarse one.
-        opt.toi_tolerance = t < 1 ? 1.0 : search.kernel().toi_tolerance;
+        // A window's filters pick its hits, which the step's kernels time; the step's own hits
+        // come with their coarse times.
+        window_filters_only = t < 1;
+        opt.toi_tolerance = search.kernel().toi_tolerance;
         opt.reuse_distance = 0;
         opt.reuse_front = false;
         if (t < 1) interpolate(x0, x1, t, xt);

@@ -23,6 +23,9 @@ struct FeatureContext {
   std::span<const FaceBoxes> face_boxes;
   /// DetectOptions::linked_vertices as (smaller, larger), sorted and unique (`sorted_links`).
   std::span<const std::pair<int, int>> links;
+  /// Every pair the filters keep counts as a hit at time 0, without a kernel: the earliest-impact
+  /// query's windows, whose hits the step's own kernels time (earliest.hpp).
+  bool filters_only = false;
 
   [[nodiscard]] bool grouped(int u, int v) const {
     if (links.empty()) return false;
@@ -213,6 +216,10 @@ struct FeatureContext {
           distance_filter_culls(q, 0.0, kZeroThicknessDepth)))) {
       ++culled;
       return false;
+    }
+    if (filters_only) {
+      toi = 0;
+      return true;
     }
     const CcdResult r =
         kept && ccd.thickness == 0 ? ccd_kernel_np_kept(q, ccd) : ccd_kernel(q, ccd);

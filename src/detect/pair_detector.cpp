@@ -149,6 +149,8 @@ struct PairDetector::Impl {
   DetectOptions opt;
   Side a, b;
   bool restricted = false;
+  // Set by earliest_impact() for its windows only (FeatureContext::filters_only).
+  bool window_filters_only = false;
 
   Impl(std::vector<Face> fa, int na, detail::PointsIn ra, std::vector<Face> fb, int nb,
        detail::PointsIn rb, const DetectOptions& o)
@@ -240,6 +242,7 @@ struct PairDetector::Impl {
 
     t = Clock::now();
     detail::FeatureContext ca = detail::ccd_context(a.topo, a.x0, a.x1, opt);
+    ca.filters_only = window_filters_only;
     detail::FeatureContext cb = detail::ccd_context(b.topo, b.x0, b.x1, opt);
     a.boxes.update(ca, a.step);
     b.boxes.update(cb, b.step);
@@ -360,13 +363,17 @@ struct PairDetector::Impl {
     struct Restore {
       Impl& m;
       const DetectOptions& saved;
-      ~Restore() { m.opt = saved; }
+      ~Restore() {
+        m.opt = saved;
+        m.window_filters_only = false;
+      }
     } restore{*this, saved};
     return detail::search_windows(
         first, slack, search, [&](double t, double sl, DetectStats& stats) {
           opt = saved;
           opt.thickness = saved.thickness + sl;
-          opt.toi_tolerance = t < 1 ? 1.0 : search.kernel().toi_tolerance;
+          opt.toi_tolerance = search.kernel().toi_tolerance;
+          window_filters_only = t < 1;
           opt.reuse_front = false;
           if (t < 1) {
             detail::interpolate(x[0], x[1], t, at);

@@ -120,6 +120,8 @@ struct SelfCore {
   // module; and whether the refit computes the optimal cones (research only).
   Rule cull = Rule::None;
   bool optimal_cones = false;
+  // Set by earliest_impact() for its windows only (FeatureContext::filters_only).
+  bool window_filters_only = false;
 
   SelfCore(std::vector<Face> faces, int nv, PointsIn ref, const DetectOptions& o);
   /// Replaces the options (checked; the build must stay) and resets what depended on them.
