@@ -1,12 +1,12 @@
 #pragma once
 // The earliest-impact query of both detectors, as detections over time windows. A window [0, T]
-// is the sub-step x0 -> x(T) = x0 + T (x1 - x0), detected by the detector's own pipeline (boxes,
-// traversal, filters, kernels) at the thickness plus an allowance for the rounding of x(T): its
-// boxes and filters see only the motion up to T, so a short window holds few candidate pairs and
-// filters away almost all of them. Its hits are the pairs that may touch by T; the step's own
-// kernels time them (over the whole step, as detect() would), and a time by T is a contact of
-// the window. Only a window without one leads to the next, [0, 1] (the step itself). The
-// earliest times are then refined to the query's tolerance (EarliestSearch).
+// is the sub-step x0 -> x(T) = x0 + T (x1 - x0), run through the detector's own pipeline (boxes,
+// traversal, filters; FeatureContext::filters_only) at the thickness plus an allowance for the
+// rounding of x(T): its boxes and filters see only the motion up to T, so a short window holds
+// few candidate pairs and filters away almost all of them. Its hits, the pairs the filters keep,
+// may touch by T; the step's own kernels time them (over the whole step, as detect() would), and
+// a time by T is a contact of the window. Only a window without one leads to the next, [0, 1] (the
+// step itself). The earliest times are then refined to the query's tolerance (EarliestSearch).
 //
 // Why a window answers for the step: every pair that comes within h before T comes, in the
 // computed sub-step, within h plus the allowance (each interpolated position lies within
@@ -71,9 +71,9 @@ inline void interpolate(std::span<const Eigen::Vector3d> x0, std::span<const Eig
 /// Adds a window's counters and times into the query's.
 void add_stats(const DetectStats& window, DetectStats& total);
 
-/// The time tolerance of the windows' kernels and of the step's kernels on their hits: each pair
-/// is timed to this first, and only the pairs that can still come first are refined to the
-/// query's tolerance (refine_time_of_impact).
+/// The time tolerance of the step's kernels on the windows' hits and of the step's own detection:
+/// each pair is timed to this first, and only the pairs that can still come first are refined to
+/// the query's tolerance (refine_time_of_impact).
 inline constexpr double kCoarseToiTolerance = 1e-4;
 
 /// The hits of the windows, timed by the step's own kernels, and the earliest of them refined.

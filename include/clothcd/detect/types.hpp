@@ -153,7 +153,8 @@ struct EarliestImpact {
   /// (then [0, 1]).
   int windows = 0;
   double first_window = 1;
-  /// Summed over the windows; the collision counts are those of the windows' detections.
+  /// Summed over the windows; the collision counts are the windows' hits (in a short window,
+  /// the pairs its filters keep).
   DetectStats stats;
 };
 
