@@ -64,7 +64,7 @@ struct SolverOptions {
   /// friction); after how many of a substep's first CCD passes' projections it runs again,
   /// holding the vertices the projection changed; its sweeps there at most (each call continues
   /// where the last stopped). Later passes run without it, so that CCD settles the motion.
-  int strain_sweeps = 20;
+  int strain_sweeps = 40;
   int strain_ccd_passes = 2;
   int strain_ccd_sweeps = 4;
 };
