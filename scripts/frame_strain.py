@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Strain of the frames of a `clothcd simulate` folder, measured from its mesh files alone.
 
-Usage: scripts/frame_strain.py [--first N] [--last N] [--json OUT] DIR [DIR ...]
+Usage: scripts/frame_strain.py [--first N] [--last N] [--json OUT] [--manifest]
+                               [--over P99,P999,MAX] DIR [DIR ...]
 
 Strain is a triangle's largest principal stretch against its rest shape, minus 1 (the manifest's
 `strain`). The rest shape comes from the scene the folder's manifest names: the `vt` pattern of
@@ -10,7 +11,10 @@ non-degenerate rest shape counts, slivers included; quantiles are nearest rank, 
 Prints one markdown row per folder with the range of the per-frame median, p90, p99, p99.9,
 largest strain and share over 10%, over the frames first..last (all by default); --json writes
 the per-frame figures. Runs of any version can be measured, so figures of runs made before the
-manifest had them are comparable with those after.
+manifest had them are comparable with those after. --manifest takes the figures from the
+manifest's per-frame `strain` instead (the simulator's own, from the same formula; fast).
+--over adds a column with the number of frames whose p99, p99.9 and largest strain exceed the
+three given fractions, e.g. --over 0.05,0.1,0.2.
 """
 import json
 import math
@@ -115,15 +119,29 @@ def measure(folder: Path, first: int, last: int):
     return m["scene"], frames
 
 
+def from_manifest(folder: Path, first: int, last: int):
+    m = json.loads((folder / "manifest.json").read_text())
+    keys = ("median", "p90", "p99", "p999", "max", "over_10")
+    frames = {f["frame"]: {k: f["strain"][k] for k in keys} for f in m["frames"]
+              if "strain" in f and first <= f["frame"] <= last}
+    return m["scene"], frames
+
+
 def span(values, scale=100.0):
     return f"{scale * min(values):.1f}-{scale * max(values):.1f}%"
 
 
 def main(argv):
-    first, last, out, folders = 1, 10**9, None, []
+    first, last, out, folders, use_manifest, over = 1, 10**9, None, [], False, None
     it = iter(argv)
     for a in it:
-        if a == "--first":
+        if a == "--manifest":
+            use_manifest = True
+        elif a == "--over":
+            over = [float(t) for t in next(it).split(",")]
+            if len(over) != 3:
+                raise SystemExit("--over takes three fractions: P99,P999,MAX")
+        elif a == "--first":
             first = int(next(it))
         elif a == "--last":
             last = int(next(it))
@@ -134,16 +152,25 @@ def main(argv):
     if not folders:
         print(__doc__, file=sys.stderr)
         return 2
-    print("| run | frames | median | p90 | p99 | p99.9 | max per frame | over 10% |")
-    print("|---|---|---|---|---|---|---|---|")
+    head = "| run | frames | median | p90 | p99 | p99.9 | max per frame | over 10% |"
+    rule = "|---|---|---|---|---|---|---|---|"
+    if over:
+        head += (f" frames over p99 {100 * over[0]:g}% / p99.9 {100 * over[1]:g}% / "
+                 f"max {100 * over[2]:g}% |")
+        rule += "---|"
+    print(head)
+    print(rule)
     dump = {}
     for folder in folders:
-        scene, frames = measure(folder, first, last)
+        scene, frames = (from_manifest if use_manifest else measure)(folder, first, last)
         dump[str(folder)] = frames
         if not frames:
             continue
         f = list(frames.values())
         cells = [span([x[k] for x in f]) for k in ("median", "p90", "p99", "p999", "max", "over_10")]
+        if over:
+            cells.append(" / ".join(str(sum(1 for x in f if x[k] > t))
+                                    for k, t in zip(("p99", "p999", "max"), over)))
         print(f"| {scene} | {min(frames)}-{max(frames)} | " + " | ".join(cells) + " |")
     if out:
         out.write_text(json.dumps(dump, indent=1) + "\n")

@@ -91,6 +91,11 @@ struct ContactHandler::Impl {
     std::vector<std::uint8_t> touched(geometry.model().num_vertices(), 0);
     std::vector<int> active;
     projection.clear();
+    // Before the first pass, which tests every pair: what it changes costs no extra pass.
+    if (ctx.after_projection) {
+      PartClock clock(times.response_s);
+      ctx.after_projection(v, touched);
+    }
     bool clean = false;
     for (int pass = 0; pass < opt.ccd_iterations; ++pass) {
       const std::vector<detail::Contact> hs =

@@ -52,6 +52,7 @@ struct ClothSolver::Impl {
   CouplingTerms couplings;
   std::optional<CoarseSpace> coarse;
   StrainLimiter limiter;
+  std::vector<double> held_inverse_mass;  // inverse_mass, 0 where a CCD projection acted
   std::vector<Vec3> support;  // per vertex: the body contact's normal while held, else zero
   std::vector<std::uint8_t> body_contact;  // vertices of the last accepted substep's constraints
 
@@ -241,19 +242,30 @@ bool ClothSolver::try_step(ClothState& state, double h, double tolerance, StepSt
     stats.strain_seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
-  // Again after the first CCD passes' projections, which stop single vertices while their
-  // neighbours move on; the next pass tests what the limiter moved.
-  if (handler_ != nullptr && im.limiter.enabled() && options_.strain_ccd_passes > 0) {
+  // Again in the collision stage: once before its first CCD pass (repulsion and friction
+  // changed velocities everywhere; that pass tests every pair anyway), then after the first
+  // passes' projections, which stop single vertices while their neighbours move on. There the
+  // vertices the projection changed are held: the limiter drags their neighbours after them
+  // instead of undoing the projection, which would only bring the same hits back. The next pass
+  // tests what the limiter moved.
+  if (handler_ != nullptr && im.limiter.enabled()) {
     ctx.after_projection = [&, calls = 0](std::span<Vec3> v,
                                           std::span<std::uint8_t> touched) mutable {
-      if (++calls > options_.strain_ccd_passes) return;
+      if (calls++ > options_.strain_ccd_passes) return;  // the first call is before the passes
       const auto t0 = std::chrono::steady_clock::now();
-      // The first call checks every triangle (repulsion and friction changed velocities
-      // everywhere), later ones only around what the last projection changed.
       std::span<const std::uint8_t> start;
-      if (calls > 1) start = touched;
-      const StrainLimitStats ls = im.limiter.apply(state.x, h, im.inverse_mass, im.support, v,
-                                                   options_.strain_ccd_sweeps, start);
+      std::span<const double> inverse_mass = im.inverse_mass;
+      if (calls > 1) {
+        start = touched;
+        im.held_inverse_mass.assign(im.inverse_mass.begin(), im.inverse_mass.end());
+        for (int i = 0; i < n; ++i) {
+          if (touched[i]) im.held_inverse_mass[i] = 0.0;
+        }
+        inverse_mass = im.held_inverse_mass;
+      }
+      const int sweeps = calls == 1 ? options_.strain_sweeps : options_.strain_ccd_sweeps;
+      const StrainLimitStats ls =
+          im.limiter.apply(state.x, h, inverse_mass, im.support, v, sweeps, start);
       stats.strain.sweeps += ls.sweeps;
       stats.strain.projections += ls.projections;
       const auto moved = im.limiter.moved();

@@ -2,9 +2,13 @@
 // gently, the body has infinite mass. (Whole scenes: collision_scenes_test.cpp.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <span>
 #include <utility>
+#include <vector>
 
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/sim/contact_handler.hpp"
@@ -141,6 +145,49 @@ TEST(ContactHandler, StopsTwoTrianglesCrossing) {
     EXPECT_GT(s.x1[i].y(), s.x1[0].y());
   // Pair impulses are internal: momentum is unchanged.
   EXPECT_LT((total_momentum(m, s.v) - p0).norm(), 1e-12);
+}
+
+// The strain limiter's hook: called once before the first CCD pass with nothing flagged, then
+// after each projection with the vertices it changed; what the hook moves, before the first pass
+// or after a projection, is tested by the passes that follow, so the motion stays crossing-free.
+TEST(ContactHandler, HookRunsBeforeTheFirstPassAndAfterEachProjection) {
+  const ClothModel m(two_triangles(0.01), ClothMaterial{});
+  const double h = 0.01;
+  std::vector<Vec3> v(6, Vec3::Zero());  // at rest: only the hook makes them move
+  const HandlerSubstep sub(m, h, {}, nullptr, {});
+  SubstepContext ctx = sub.ctx;
+  std::vector<int> flagged_per_call;
+  ctx.after_projection = [&](std::span<Vec3> vh, std::span<std::uint8_t> touched) {
+    flagged_per_call.push_back(
+        static_cast<int>(std::count(touched.begin(), touched.end(), std::uint8_t{1})));
+    if (flagged_per_call.size() == 1) {
+      // Before the first pass: send the upper triangle 2 cm down through the lower one.
+      for (int i = 3; i < 6; ++i)
+        vh[i] = Vec3(0.3, -2.0, 0.1);
+    } else if (flagged_per_call.size() == 2) {
+      // After the first projection: push vertex 3 down again, and flag it.
+      vh[3] = Vec3(0.0, -2.0, 0.0);
+      touched[3] = 1;
+    }
+  };
+  ContactHandler handler(m, ContactOptions{});
+  handler.prepare(ctx);
+  const CollisionStats st = handler.respond(ctx, v);
+  ASSERT_GE(flagged_per_call.size(), 2u);
+  EXPECT_EQ(flagged_per_call[0], 0);
+  EXPECT_GT(flagged_per_call[1], 0);
+  EXPECT_EQ(static_cast<int>(flagged_per_call.size()), st.ccd_passes);  // + 1 before, - 1 clean
+  EXPECT_GT(st.ccd_hits, 0);
+  EXPECT_EQ(st.unresolved, 0);
+  std::vector<Vec3> x1;
+  for (int i = 0; i < 6; ++i)
+    x1.push_back(m.initial_positions()[i] + h * v[i]);
+  SelfDetector d(m.topology().faces(), 6, to_matrix(m.initial_positions()));
+  const DetectResult r = d.detect(to_matrix(m.initial_positions()), to_matrix(x1));
+  EXPECT_TRUE(r.vf.empty());
+  EXPECT_TRUE(r.ee.empty());
+  for (int i = 3; i < 6; ++i)
+    EXPECT_GT(x1[i].y(), x1[0].y());
 }
 
 TEST(ContactHandler, RepelsWithinThicknessWithoutPopping) {

@@ -139,6 +139,42 @@ TEST(StrainLimiter, CompressionLimitAndPinnedVertices) {
   }
 }
 
+// Inside the collision stage the limiter holds the vertices a CCD projection stopped (inverse
+// mass 0 there): they keep their motion, and their neighbours follow them back within the limit.
+TEST(StrainLimiter, HeldVertexKeepsItsMotionAndItsNeighboursFollow) {
+  ClothMaterial mat;
+  mat.strain_limit = 1.05;
+  const ClothModel m(grid_cloth(16, 16, 0.16, 0.16), mat);
+  StrainLimiter limiter(m);
+  const std::vector<Vec3> x0 = m.initial_positions();
+  const double h = 0.01;
+  // Everything moves 1 cm along z but the centre vertex, which a projection stopped.
+  std::vector<Vec3> v(x0.size(), Vec3(0.0, 0.0, 1.0));
+  const int held = 8 * 17 + 8;
+  v[held] = Vec3::Zero();
+  auto ends = [&] {
+    std::vector<Vec3> x(x0.size());
+    for (std::size_t i = 0; i < x0.size(); ++i)
+      x[i] = x0[i] + h * v[i];
+    return x;
+  };
+  ASSERT_GT(largest(triangle_strains(m, ends())), 0.3);
+  std::vector<double> inverse_mass(x0.size(), 1.0);
+  inverse_mass[held] = 0.0;
+  std::vector<std::uint8_t> start(x0.size(), 0);
+  start[held] = 1;  // only the triangles around it are checked first
+  const StrainLimitStats st = limiter.apply(x0, h, inverse_mass, {}, v, 200, start);
+  EXPECT_GT(st.projections, 0);
+  EXPECT_EQ(v[held], Vec3(0.0, 0.0, 0.0));
+  EXPECT_LT(largest(triangle_strains(m, ends())), 0.05 + 1e-3);
+  // Its neighbours were dragged back towards it; far corners kept moving.
+  EXPECT_LT(v[held + 1].z(), 0.9);
+  EXPECT_EQ(v[0], Vec3(0.0, 0.0, 1.0));
+  // Only what moved is reported.
+  EXPECT_EQ(limiter.moved()[0], 0);
+  EXPECT_EQ(limiter.moved()[held + 1], 1);
+}
+
 TEST(StrainLimiter, BitwiseDeterministicAcrossThreadCounts) {
   ClothMaterial mat;
   mat.strain_limit = 1.04;
@@ -157,6 +193,18 @@ TEST(StrainLimiter, BitwiseDeterministicAcrossThreadCounts) {
       StrainLimiter limiter(m);
       std::vector<Vec3> v = v0;
       limiter.apply(x0, h, inverse_mass, {}, v, 8);
+      // A second call as in the collision stage: from flagged vertices, some held, some on a
+      // support plane (continuing where the first stopped).
+      std::vector<std::uint8_t> start(x0.size(), 0);
+      std::vector<double> held = inverse_mass;
+      std::vector<Vec3> support(x0.size(), Vec3::Zero());
+      for (std::size_t i = 0; i < x0.size(); i += 7) {
+        start[i] = 1;
+        if (i % 3 == 0) held[i] = 0.0;
+        if (i % 5 == 0) support[i] = Vec3::UnitY();
+        v[i] *= 1.5;
+      }
+      limiter.apply(x0, h, held, support, v, 4, start);
       hashes.push_back(test::hash_positions(v));
     });
   }

@@ -27,9 +27,10 @@ struct SubstepContext {
   std::span<const Vec3> body_t0;  ///< body vertices at t0 and t0 + h (empty: no body)
   std::span<const Vec3> body_t1;
   const std::vector<Face>* body_faces = nullptr;
-  /// Optional: called after each CCD pass's projection with v and one flag per cloth vertex
-  /// (set: its velocity changed); it may change v (the strain limiter does) and must flag every
-  /// vertex it changes, so the next pass tests them.
+  /// Optional: called once before the first CCD pass (after repulsion and friction, no vertex
+  /// flagged) and after each CCD pass's projection, with v and one flag per cloth vertex (set:
+  /// the projection changed its velocity); it may change v (the strain limiter does) and must
+  /// flag every vertex it changes, so the next pass tests them.
   std::function<void(std::span<Vec3>, std::span<std::uint8_t>)> after_projection;
 };
 

@@ -59,12 +59,13 @@ struct SolverOptions {
   /// Also halve a substep whose collision response leaves CCD hits unresolved (the impact
   /// zones gave up): a shorter substep asks of each zone a motion closer to its anchors'.
   bool halve_unresolved = true;
-  /// Strain limiter (ClothMaterial::strain_limit): Gauss-Seidel sweeps on the solve's result at
-  /// most; after how many of a substep's first CCD passes' projections it runs again; its sweeps
-  /// there at most (each call continues where the last stopped). Later passes run without it,
-  /// so that CCD settles the motion.
-  int strain_sweeps = 20;
-  int strain_ccd_passes = 6;
+  /// Strain limiter (ClothMaterial::strain_limit): Gauss-Seidel sweeps at most on the solve's
+  /// result and again before the collision stage's first CCD pass (after repulsion and
+  /// friction); after how many of a substep's first CCD passes' projections it runs again,
+  /// holding the vertices the projection changed; its sweeps there at most (each call continues
+  /// where the last stopped). Later passes run without it, so that CCD settles the motion.
+  int strain_sweeps = 40;
+  int strain_ccd_passes = 2;
   int strain_ccd_sweeps = 4;
 };
 
