@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "bvh/traversal.hpp"
 #include "clothcd/research/procedural.hpp"
-#include "detect/traversal.hpp"
 
 // Helpers in a namespace of their own: the tests of a folder may share one translation unit.
 namespace clothcd::traverse_test {

@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "api_scenes.hpp"
+#include "bvh/front.hpp"
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/bvh/traverse.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/mesh/topology.hpp"
 #include "clothcd/research/procedural.hpp"
-#include "detect/front.hpp"
 
 namespace clothcd {
 namespace {
