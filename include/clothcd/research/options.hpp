@@ -48,8 +48,8 @@ struct Options {
   bool optimal_cones = false;
   /// Also run the unculled traversal and narrow phase on the same step and report in
   /// DetectResult::verification what the culled detection missed. The step then costs about a
-  /// culled and an unculled detection together. Nothing is run with Culling::None and no unsound
-  /// rule.
+  /// culled and an unculled detection together. Nothing is run when the rule run is
+  /// CullingRule::None.
   bool verify = false;
   bool operator==(const Options&) const = default;
 };
