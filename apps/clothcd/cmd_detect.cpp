@@ -42,12 +42,15 @@ struct Args {
   std::string t0, t1, json;
   std::string policy = "proposed", culling = "none", bvh = "spatial";
   double weld = 0, sew = 0, thickness = 0;
+  double toi_tolerance = -1;  // unset: each mode's default
+  double first_window = 0;
   double perturb = 0, wavelength = 0.2;
   std::uint64_t seed = 1;
   int garment_vertices = -1;
   int threads = 0;
   int cull_min_triangles = 0;
   bool verify = false, table = false, table_optimal = false, no_distance_filter = false;
+  bool earliest = false;
 };
 
 nlohmann::json stats_json(const DetectStats& s) {
@@ -228,6 +231,50 @@ void print_table(const TriangleMesh& w0, const TriangleMesh& w1, double thicknes
   }
 }
 
+// --earliest: the earliest time of impact of the step and its pair, printed and as JSON.
+void run_earliest(const Args& a, SelfDetector& det, const TriangleMesh& w0, const TriangleMesh& w1,
+                  const std::vector<int>& original) {
+  EarliestOptions eo;
+  if (a.toi_tolerance >= 0) eo.toi_tolerance = a.toi_tolerance;
+  eo.first_window = a.first_window;
+  const EarliestImpact e = det.earliest_impact(vertices_matrix(w0), vertices_matrix(w1), eo);
+  const DetectStats& s = e.stats;
+  const Topology& topo = det.topology();
+  // The pair as vertex ids of the input files (as --json writes collisions).
+  nlohmann::json ids = nlohmann::json::array();
+  std::string kind = "none", what = "nothing comes within the thickness";
+  if (e.kind == EarliestImpact::Kind::VertexFace) {
+    const Face& f = topo.faces()[e.ids[1]];
+    kind = "vf";
+    ids = {original[e.ids[0]], {original[f[0]], original[f[1]], original[f[2]]}};
+    what = fmt::format("vertex {} and face ({}, {}, {})", original[e.ids[0]], original[f[0]],
+                       original[f[1]], original[f[2]]);
+  } else if (e.kind == EarliestImpact::Kind::EdgeEdge) {
+    const Edge& p = topo.edges()[e.ids[0]];
+    const Edge& q = topo.edges()[e.ids[1]];
+    kind = "ee";
+    ids = {{original[p[0]], original[p[1]]}, {original[q[0]], original[q[1]]}};
+    what = fmt::format("edges ({}, {}) and ({}, {})", original[p[0]], original[p[1]],
+                       original[q[0]], original[q[1]]);
+  }
+  fmt::print(
+      "earliest impact: toi {} ({}), {} time window(s) from [0, {}]\ntriangle pairs {}, VF tests "
+      "{}, EE tests "
+      "{}\ntime: refit {:.4f} s, traversal {:.4f} s, narrow phase {:.4f} s\n",
+      e.toi, what, e.windows, e.first_window, s.triangle_pairs, s.vf_tests, s.ee_tests,
+      s.time_refit, s.time_traverse, s.time_narrow);
+  if (!a.json.empty()) {
+    nlohmann::json j;
+    nlohmann::json stats = stats_json(s);
+    stats["windows"] = e.windows;
+    stats["first_window"] = e.first_window;
+    j["earliest"] = {{"toi", e.toi}, {"kind", kind}, {"ids", ids}};
+    j["stats"] = stats;
+    clothcd::io_detail::write_atomically(a.json,
+                                         [&](std::ostream& out) { out << j.dump(1) << "\n"; });
+  }
+}
+
 int run(const Args& a) {
   DetectOptions o;
   research::set_cone_rule(o, research::parse_cone_rule(a.policy, "--policy"));
@@ -241,6 +288,11 @@ int run(const Args& a) {
   o.cull_min_triangles = a.cull_min_triangles;
   o.distance_filter = !a.no_distance_filter;
   o.research.verify = a.verify;
+  if (a.toi_tolerance >= 0 && !a.earliest) o.toi_tolerance = a.toi_tolerance;
+  if (a.earliest && (a.table || a.verify)) {
+    throw InputError("--earliest reports one pair; drop --table and --verify");
+  }
+  if (a.first_window != 0 && !a.earliest) throw InputError("--first-window needs --earliest");
   const auto start = std::chrono::steady_clock::now();
   const auto since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -284,6 +336,11 @@ int run(const Args& a) {
   const auto built = std::chrono::steady_clock::now();
   SelfDetector det(w0.faces, w0.num_vertices(), vertices_matrix(w0), o);
   const double setup = since(built);
+  if (a.earliest) {
+    run_earliest(a, det, w0, w1, original);
+    fmt::print("setup: reading {:.4f} s, detector {:.4f} s\n", reading, setup);
+    return 0;
+  }
   const DetectResult r = det.detect(vertices_matrix(w0), vertices_matrix(w1));
   const DetectStats& s = r.stats;
   fmt::print(
@@ -345,6 +402,15 @@ const bool registered = clothcd::app::register_command(
                    "print a table of every BVH build, culling mode and cone policy instead");
       sub.add_flag("--table-optimal", a->table_optimal, "include the OPTIMAL policy in --table");
       sub.add_option("--json", a->json, "write collisions and statistics to this JSON file");
+      sub.add_flag("--earliest", a->earliest,
+                   "report only the earliest time of impact and its pair (the collision-free "
+                   "step of a line search) instead of every collision");
+      sub.add_option("--toi-tolerance", a->toi_tolerance,
+                     "how far early a time of impact may be (default 1e-4; with --earliest 1e-6)")
+          ->check(CLI::PositiveNumber);
+      sub.add_option("--first-window", a->first_window,
+                     "with --earliest: the first time window [0, T], T a power of two in (0, 1] "
+                     "(default: from the motion)");
       return [a] { return run(*a); };
     });
 

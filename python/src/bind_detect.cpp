@@ -190,6 +190,25 @@ struct PairResult {
   }
 };
 
+// EarliestImpact as Python's (toi, kind, ids): kind "vf" | "ee" | "none" for one mesh; between
+// two meshes "vf_a_on_b" | "vf_b_on_a" | "ee" | "none".
+py::tuple earliest_tuple(const EarliestImpact& e, bool two_meshes) {
+  std::string kind = "none";
+  if (e.kind == EarliestImpact::Kind::VertexFace) {
+    kind = !two_meshes ? "vf" : e.vertex_on_b ? "vf_b_on_a" : "vf_a_on_b";
+  } else if (e.kind == EarliestImpact::Kind::EdgeEdge) {
+    kind = "ee";
+  }
+  return py::make_tuple(e.toi, kind, py::make_tuple(e.ids[0], e.ids[1]));
+}
+
+EarliestOptions earliest_options(double toi_tolerance, double first_window) {
+  EarliestOptions o;
+  o.toi_tolerance = toi_tolerance;
+  o.first_window = first_window;
+  return o;
+}
+
 // The Python SelfDetector: the library's, its worker arena and the arrays it was built from.
 class PySelfDetector {
  public:
@@ -223,6 +242,17 @@ class PySelfDetector {
                          b);
     });
     return SelfResult(r);
+  }
+
+  py::tuple earliest_impact(const ArrayLike& V0, const ArrayLike& V1, double toi_tolerance,
+                            double first_window) {
+    const PointsArg a(V0, "V0"), b(V1, "V1");
+    const EarliestOptions eo = earliest_options(toi_tolerance, first_window);
+    const EarliestImpact e = workers_.run([&] {
+      return with_points(
+          [&](const auto& x0, const auto& x1) { return det_->earliest_impact(x0, x1, eo); }, a, b);
+    });
+    return earliest_tuple(e, false);
   }
 
   ProximityOut proximity(const ArrayLike& V, double h) {
@@ -305,6 +335,17 @@ class PyPairDetector {
       return with_points([&](const auto&... x) { return det_->detect(x...); }, a0, a1, b0, b1);
     });
     return PairResult(r);
+  }
+
+  py::tuple earliest_impact(const ArrayLike& A0, const ArrayLike& A1, const ArrayLike& B0,
+                            const ArrayLike& B1, double toi_tolerance, double first_window) {
+    const PointsArg a0(A0, "Va0"), a1(A1, "Va1"), b0(B0, "Vb0"), b1(B1, "Vb1");
+    const EarliestOptions eo = earliest_options(toi_tolerance, first_window);
+    const EarliestImpact e = workers_.run([&] {
+      return with_points([&](const auto&... x) { return det_->earliest_impact(x..., eo); }, a0, a1,
+                         b0, b1);
+    });
+    return earliest_tuple(e, true);
   }
 
   [[nodiscard]] py::array_t<int> edges_a() const { return edges_array(edges_a_); }
@@ -425,6 +466,16 @@ seam): pairs joining them are not tested.)") +
            R"(All vertex-face and edge-edge pairs that touch while every vertex moves linearly
 from V0 to V1 (both (n, 3)). Results are sorted and do not depend on the thread count. The GIL
 is released while it runs.)")
+      .def("earliest_impact", &PySelfDetector::earliest_impact, py::arg("V0"), py::arg("V1"),
+           py::kw_only(), py::arg("toi_tolerance") = EarliestOptions{}.toi_tolerance,
+           py::arg("first_window") = EarliestOptions{}.first_window,
+           R"((toi, kind, ids): how far along V0 -> V1 every vertex-face and edge-edge pair stays
+farther apart than the thickness. toi is never later than the first contact (moving to
+V0 + toi (V1 - V0) is safe) and no more than toi_tolerance before the first time the reported pair
+comes within the kernels' certified distance; kind is "vf" (ids: vertex, face), "ee" (ids: edge_a,
+edge_b into `edges`) or "none" (toi 1, ids (-1, -1)). first_window: the first time window [0, T]
+searched (a power of two; 0 picks it from the motion). Independent of the thread count; the GIL is
+released while it runs.)")
       .def("proximity", &PySelfDetector::proximity, py::arg("V"), py::arg("h"),
            R"(Vertex-face and edge-edge pairs closer than h at positions V (boxes only, no cone
 culling), with their distances.)")
@@ -494,6 +545,12 @@ V_a, V_b: (n, 3) reference positions the trees are split on.)") +
       .def("detect", &PyPairDetector::detect, py::arg("Va0"), py::arg("Va1"), py::arg("Vb0"),
            py::arg("Vb1"),
            "Collisions while A moves linearly Va0 -> Va1 and B moves Vb0 -> Vb1 (GIL released).")
+      .def("earliest_impact", &PyPairDetector::earliest_impact, py::arg("Va0"), py::arg("Va1"),
+           py::arg("Vb0"), py::arg("Vb1"), py::kw_only(),
+           py::arg("toi_tolerance") = EarliestOptions{}.toi_tolerance,
+           py::arg("first_window") = EarliestOptions{}.first_window,
+           R"((toi, kind, ids) between A and B, as SelfDetector.earliest_impact: kind "vf_a_on_b"
+(ids: vertex of A, face of B), "vf_b_on_a", "ee" (edge of A, edge of B) or "none".)")
       .def_property_readonly("edges_a", &PyPairDetector::edges_a,
                              "(e, 2) int32 edges of A (the first column of ee indexes them).")
       .def_property_readonly("edges_b", &PyPairDetector::edges_b, "(e, 2) int32 edges of B.");

@@ -62,3 +62,16 @@ def test_spread_angles_and_meshio_frames(tmp_path, tiny_scene):
     lowest = [float(x) for x in re.findall(r"lowest y ([-+\d.]+)", out)]
     assert lowest == [float(f"{v:+.5f}") for v in V[:, :, 1].min(axis=1)]
     assert sorted(p.name for p in (tmp_path / "vtu").iterdir()) == [f"frame_{k:04d}.vtu" for k in range(3)]
+
+
+def test_line_search_stops_short_of_contact(tmp_path):
+    out = run("line_search.py", cwd=tmp_path)
+    steps = [float(m[1]) for m in re.finditer(r"step (\S+)", out)]
+    assert len(steps) == 4 and all(0 < s < 1 for s in steps)
+    # The path the example took, as one motion from V0: nothing comes within the thickness.
+    F, V0, V1 = clothcd.procedural.stacked_sheets(12)
+    x = V0 + sum(steps) * (V1 - V0)
+    r = clothcd.SelfDetector(F, V0, thickness=1e-3).detect(V0, x)
+    assert len(r.vf) == 0 and len(r.ee) == 0
+    full = clothcd.SelfDetector(F, V0, thickness=1e-3).detect(V0, V1)
+    assert len(full.vf) + len(full.ee) > 0  # the full step would have collided

@@ -196,6 +196,15 @@ ProximityResult SelfDetector::proximity(const Positions& v, double h) {
 ProximityResult SelfDetector::proximity(std::span<const Eigen::Vector3d> v, double h) {
   return impl_->proximity(v, h);
 }
+EarliestImpact SelfDetector::earliest_impact(const Positions& v_t0, const Positions& v_t1,
+                                             const EarliestOptions& options) {
+  return impl_->earliest_impact(v_t0, v_t1, options);
+}
+EarliestImpact SelfDetector::earliest_impact(std::span<const Eigen::Vector3d> v_t0,
+                                             std::span<const Eigen::Vector3d> v_t1,
+                                             const EarliestOptions& options) {
+  return impl_->earliest_impact(v_t0, v_t1, options);
+}
 void SelfDetector::set_active_faces(std::span<const int> faces) {
   impl_->set_active(faces);
 }

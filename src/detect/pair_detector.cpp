@@ -16,6 +16,7 @@
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
+#include "earliest.hpp"
 #include "narrow.hpp"
 #include "options.hpp"
 #include "pair_results.hpp"
@@ -320,6 +321,65 @@ struct PairDetector::Impl {
     return res;
   }
 
+  EarliestImpact earliest_impact(detail::PointsIn pa0, detail::PointsIn pa1, detail::PointsIn pb0,
+                                 detail::PointsIn pb1, const EarliestOptions& eo) {
+    detail::check_earliest_options(eo);
+    std::vector<Eigen::Vector3d> x[4], at, bt;
+    detail::to_points(pa0, a.topo.num_vertices(), "mesh A at t0", x[0]);
+    detail::to_points(pa1, a.topo.num_vertices(), "mesh A at t1", x[1]);
+    detail::to_points(pb0, b.topo.num_vertices(), "mesh B at t0", x[2]);
+    detail::to_points(pb1, b.topo.num_vertices(), "mesh B at t1", x[3]);
+    using Points = std::span<const Eigen::Vector3d>;
+    const Topology* const meshes[] = {&a.topo, &b.topo};
+    const Points s0[] = {x[0], x[2]}, s1[] = {x[1], x[3]};
+    const double first = detail::first_window(eo, meshes, s0, s1);
+    const double slack =
+        std::max(detail::rounding_slack(x[0], x[1]), detail::rounding_slack(x[2], x[3]));
+    const auto& fa = a.topo.faces();
+    const auto& fb = b.topo.faces();
+    const auto& ea = a.topo.edges();
+    const auto& eb = b.topo.edges();
+    // A vertex of one mesh against a face of the other (vertex_on_b: of B against A).
+    const auto make_vf = [&](int v, int f, bool on_b) {
+      const auto& p0 = on_b ? x[2] : x[0];
+      const auto& p1 = on_b ? x[3] : x[1];
+      const auto& q0 = on_b ? x[0] : x[2];
+      const auto& q1 = on_b ? x[1] : x[3];
+      const Face& t = on_b ? fa[f] : fb[f];
+      return VertexFaceQuery{p0[v], q0[t[0]], q0[t[1]], q0[t[2]],
+                             p1[v], q1[t[0]], q1[t[1]], q1[t[2]]};
+    };
+    const auto make_ee = [&](int i, int j) {
+      const Edge &p = ea[i], &q = eb[j];
+      return EdgeEdgeQuery{x[0][p[0]], x[0][p[1]], x[2][q[0]], x[2][q[1]],
+                           x[1][p[0]], x[1][p[1]], x[3][q[0]], x[3][q[1]]};
+    };
+    detail::EarliestSearch search(detail::ccd_context(a.topo, x[0], x[1], opt).ccd,
+                                  eo.toi_tolerance, make_vf, make_ee);
+    const DetectOptions saved = opt;
+    struct Restore {
+      Impl& m;
+      const DetectOptions& saved;
+      ~Restore() { m.opt = saved; }
+    } restore{*this, saved};
+    return detail::search_windows(
+        first, slack, search, [&](double t, double sl, DetectStats& stats) {
+          opt = saved;
+          opt.thickness = saved.thickness + sl;
+          opt.toi_tolerance = t < 1 ? 1.0 : search.kernel().toi_tolerance;
+          opt.reuse_front = false;
+          if (t < 1) {
+            detail::interpolate(x[0], x[1], t, at);
+            detail::interpolate(x[2], x[3], t, bt);
+          }
+          const PairDetectResult r = detect(Points(x[0]), Points(t < 1 ? at : x[1]), Points(x[2]),
+                                            Points(t < 1 ? bt : x[3]));
+          detail::add_stats(r.stats, stats);
+          search.add(r.vf_a_on_b, r.ee, t, false);
+          search.add(r.vf_b_on_a, {}, t, true);
+        });
+  }
+
   PairProximityResult proximity(detail::PointsIn pa, detail::PointsIn pb, double h) {
     if (!(h >= 0) || !std::isfinite(h)) {
       throw InputError(fmt::format("proximity distance must be finite and >= 0, got {}", h));
@@ -458,6 +518,18 @@ PairProximityResult PairDetector::proximity(const Positions& a, const Positions&
 PairProximityResult PairDetector::proximity(std::span<const Eigen::Vector3d> a,
                                             std::span<const Eigen::Vector3d> b, double h) {
   return impl_->proximity(a, b, h);
+}
+EarliestImpact PairDetector::earliest_impact(const Positions& a_t0, const Positions& a_t1,
+                                             const Positions& b_t0, const Positions& b_t1,
+                                             const EarliestOptions& options) {
+  return impl_->earliest_impact(a_t0, a_t1, b_t0, b_t1, options);
+}
+EarliestImpact PairDetector::earliest_impact(std::span<const Eigen::Vector3d> a_t0,
+                                             std::span<const Eigen::Vector3d> a_t1,
+                                             std::span<const Eigen::Vector3d> b_t0,
+                                             std::span<const Eigen::Vector3d> b_t1,
+                                             const EarliestOptions& options) {
+  return impl_->earliest_impact(a_t0, a_t1, b_t0, b_t1, options);
 }
 void PairDetector::set_active_vertices(std::span<const int> vertices_a,
                                        std::span<const int> vertices_b) {

@@ -231,6 +231,8 @@ struct SelfCore {
   void refit(DetectStats& st);
   DetectResult detect(PointsIn p0, PointsIn p1);
   ProximityResult proximity(PointsIn p, double h);
+  // detect() over time windows, reduced to the earliest hit (earliest.cpp).
+  EarliestImpact earliest_impact(PointsIn p0, PointsIn p1, const EarliestOptions& o);
   // Whether proximity(v0, h) can use the kept pairs: then the active restriction is set to the
   // vertices that moved since (few, or the traversal is cheaper). `reuse.valid` implies keeps():
   // only detect() sets it, and set_options() clears it.

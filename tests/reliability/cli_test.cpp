@@ -213,6 +213,47 @@ TEST(CliDetect, JsonHoldsTheDetectorsCollisionsExactly) {
   EXPECT_EQ(j.size(), 5u) << "vf, ee, missed_vf, missed_ee, stats";
 }
 
+TEST(CliDetect, EarliestWritesTheQuerysAnswer) {
+  // --earliest: the library's earliest impact, its pair as the input's vertex ids, and the
+  // stats keys of a full detection; --toi-tolerance reaches the query.
+  CliScratch dir;
+  write_step(dir);
+  const TriangleMesh m0 = read_mesh(dir / "t0.obj"), m1 = read_mesh(dir / "t1.obj");
+  SelfDetector det(m0.faces, m0.num_vertices(), vertices_matrix(m0));
+  for (const double tol : {1e-6, 1e-3}) {
+    const auto r = dir.run("detect --t0 t0.obj --t1 t1.obj --earliest --toi-tolerance " +
+                           std::to_string(tol) + " --json out.json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(CliScratch::slurp(dir / "out.json"));
+    EarliestOptions eo;
+    eo.toi_tolerance = std::stod(std::to_string(tol));
+    const EarliestImpact want = det.earliest_impact(vertices_matrix(m0), vertices_matrix(m1), eo);
+    ASSERT_NE(want.kind, EarliestImpact::Kind::None);
+    EXPECT_EQ(j["earliest"]["toi"].get<double>(), want.toi);
+    const Topology& t = det.topology();
+    if (want.kind == EarliestImpact::Kind::VertexFace) {
+      const Face& f = t.faces()[want.ids[1]];
+      EXPECT_EQ(j["earliest"]["kind"], "vf");
+      EXPECT_EQ(j["earliest"]["ids"], nlohmann::json({want.ids[0], {f[0], f[1], f[2]}}));
+    } else {
+      const Edge &a = t.edges()[want.ids[0]], &b = t.edges()[want.ids[1]];
+      EXPECT_EQ(j["earliest"]["kind"], "ee");
+      EXPECT_EQ(j["earliest"]["ids"], nlohmann::json({{a[0], a[1]}, {b[0], b[1]}}));
+    }
+    for (const char* key : {"time_refit", "time_traverse", "time_narrow", "triangle_pairs"})
+      EXPECT_TRUE(j["stats"].contains(key)) << key;
+    EXPECT_EQ(j.size(), 2u) << "earliest, stats";
+  }
+  // Settings it cannot honour: an error, and no output file.
+  for (const char* bad : {"--earliest --first-window 0.3", "--earliest --table",
+                          "--first-window 0.5", "--earliest --toi-tolerance 0"}) {
+    const auto r =
+        dir.run(std::string("detect --t0 t0.obj --t1 t1.obj ") + bad + " --json bad.json");
+    EXPECT_NE(r.code, 0) << bad;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.json")) << bad;
+  }
+}
+
 TEST(CliDetect, ThicknessReportsTrianglePairsCulledWhole) {
   // The whole-triangle distance bound culls whole triangle pairs first: the count is in the JSON
   // and the summary. With a thickness it is part of the distance filter; at zero thickness it

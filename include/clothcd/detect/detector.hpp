@@ -89,6 +89,20 @@ class SelfDetector {
   [[nodiscard]] ProximityResult proximity(const Positions& v, double h);
   [[nodiscard]] ProximityResult proximity(std::span<const Eigen::Vector3d> v, double h);
 
+  /// How far along the linear motion v_t0 -> v_t1 every VF and EE pair stays farther apart than
+  /// the thickness: the earliest time of impact, and the pair (EarliestImpact gives the
+  /// guarantee). The pairs are the ones detect() tests (less linked pairs, within the active
+  /// restriction), through detect()'s pipeline: the earliest hit of a detection over a short
+  /// window [0, T] first, of the whole step only where that window holds none (docs/detect.md
+  /// "Earliest impact"). Does not depend on the thread count. Leaves what detect() keeps for later
+  /// calls (DetectOptions::reuse_distance, reuse_front) as it was. Throws InputError for bad
+  /// positions or options.
+  [[nodiscard]] EarliestImpact earliest_impact(const Positions& v_t0, const Positions& v_t1,
+                                               const EarliestOptions& options = {});
+  [[nodiscard]] EarliestImpact earliest_impact(std::span<const Eigen::Vector3d> v_t0,
+                                               std::span<const Eigen::Vector3d> v_t1,
+                                               const EarliestOptions& options = {});
+
   /// The active restriction, which detect() and proximity() honour until clear_active() (or a
   /// rebuild()). A call of either setter replaces the restriction the other set.
   /// set_active_faces: pairs in which at least one feature belongs to an active triangle.
@@ -176,6 +190,18 @@ class PairDetector {
   [[nodiscard]] PairProximityResult proximity(const Positions& a, const Positions& b, double h);
   [[nodiscard]] PairProximityResult proximity(std::span<const Eigen::Vector3d> a,
                                               std::span<const Eigen::Vector3d> b, double h);
+
+  /// The earliest time at which a VF or EE pair between A and B comes within the thickness
+  /// during the motions (SelfDetector::earliest_impact between two meshes: the same guarantee;
+  /// EarliestImpact::vertex_on_b tells the VF pairs' sides), within the active restriction.
+  [[nodiscard]] EarliestImpact earliest_impact(const Positions& a_t0, const Positions& a_t1,
+                                               const Positions& b_t0, const Positions& b_t1,
+                                               const EarliestOptions& options = {});
+  [[nodiscard]] EarliestImpact earliest_impact(std::span<const Eigen::Vector3d> a_t0,
+                                               std::span<const Eigen::Vector3d> a_t1,
+                                               std::span<const Eigen::Vector3d> b_t0,
+                                               std::span<const Eigen::Vector3d> b_t1,
+                                               const EarliestOptions& options = {});
 
   /// Restricts detect() and proximity() to pairs with an active vertex (ids of A and of B), until
   /// clear_active() (or a rebuild()): a VF pair when its vertex or a vertex of its face is active,

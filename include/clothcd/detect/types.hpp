@@ -2,6 +2,7 @@
 /// @file
 /// Options, collisions and statistics of the collision detection pipeline.
 
+#include <array>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -114,6 +115,46 @@ struct DetectStats {
   [[nodiscard]] double connected_share() const {
     return internal_nodes > 0 ? double(connected_internal_nodes) / internal_nodes : 1.0;
   }
+};
+
+/// Settings of an earliest-impact query (SelfDetector::earliest_impact,
+/// PairDetector::earliest_impact); the thickness, filters, links and restriction are the
+/// detector's.
+struct EarliestOptions {
+  /// How much earlier than the first contact the reported time may be (> 0): the kernels refine
+  /// the winning pair's time of impact to this.
+  double toi_tolerance = 1e-6;
+  /// The first time window searched, [0, first_window] (a power of two in (0, 1]); 0 picks it
+  /// from the motion: the largest window in which no vertex moves farther than 1/64 of the
+  /// mesh's mean edge length. Only a window that holds no contact leads to the next one, [0, 1].
+  /// Results never depend on the thread count; they may differ between windows by at most the
+  /// tolerance above.
+  double first_window = 0;
+  bool operator==(const EarliestOptions&) const = default;
+};
+
+/// The earliest contact of one step: how far along the motion every feature pair stays farther
+/// apart than the thickness.
+struct EarliestImpact {
+  enum class Kind : std::uint8_t { None, VertexFace, EdgeEdge };
+  /// Never later than the first time at which a VF or EE pair comes within the thickness (moving
+  /// every vertex to x0 + toi (x1 - x0) is safe), and no earlier than the first time at which
+  /// that pair comes within sqrt(3) (thickness + 1e-6 L) (L the pair's extent; the kernels'
+  /// certification), less toi_tolerance. 1 with Kind::None when no pair comes that close.
+  double toi = 1.0;
+  Kind kind = Kind::None;
+  /// VertexFace: {vertex, face}; EdgeEdge: {edge_a, edge_b} (Topology edge ids; for one mesh
+  /// edge_a < edge_b, between two meshes an edge of A and an edge of B); None: {-1, -1}. Of the
+  /// pairs with the same toi, the one of smallest (kind, ids).
+  std::array<int, 2> ids{-1, -1};
+  /// Between two meshes (PairDetector), for VertexFace: the vertex is B's and the face A's.
+  bool vertex_on_b = false;
+  /// Time windows searched: 1 ([0, first_window] held the answer, or was the whole step), or 2
+  /// (then [0, 1]).
+  int windows = 0;
+  double first_window = 1;
+  /// Summed over the windows; the collision counts are those of the windows' detections.
+  DetectStats stats;
 };
 
 struct DetectResult {
