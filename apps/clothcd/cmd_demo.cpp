@@ -238,18 +238,18 @@ struct DemoArgs {
   double from = 0.6, to = 0.65;  // the step: this part of the scene's motion
 };
 
-ProceduralScene demo_scene(const DemoArgs& a) {
+research::ProceduralScene demo_scene(const DemoArgs& a) {
   if (a.size < 0) throw InputError(fmt::format("demo: --size must be >= 0, got {}", a.size));
   if (!(0 <= a.from && a.from < a.to && a.to <= 1)) {
     throw InputError(
         fmt::format("demo: need 0 <= --from < --to <= 1, got {} and {}", a.from, a.to));
   }
-  ProceduralScene s;
+  research::ProceduralScene s;
   if (a.scene == "crumpled") {
-    s = crumpled_sheet(a.size > 0 ? a.size : 120, a.seed);
+    s = research::crumpled_sheet(a.size > 0 ? a.size : 120, a.seed);
   } else if (a.scene == "twisted") {
     const int n = a.size > 0 ? a.size : 800;
-    s = twisted_strip(n, std::max(2, n / 40));
+    s = research::twisted_strip(n, std::max(2, n / 40));
   } else {
     throw InputError(fmt::format("demo: unknown --scene '{}' (crumpled|twisted)", a.scene));
   }
@@ -270,7 +270,7 @@ int run_detection_demo(const DemoArgs& a) {
     threads.emplace(tbb::global_control::max_allowed_parallelism,
                     static_cast<std::size_t>(a.threads));
   }
-  const ProceduralScene s = demo_scene(a);
+  const research::ProceduralScene s = demo_scene(a);
   research::DetectOptions o;
   o.build = build;
   const auto t = std::chrono::steady_clock::now();

@@ -162,7 +162,8 @@ std::pair<TriangleMesh, TriangleMesh> load_frames(const Args& a) {
   }
   if (a.perturb > 0) {
     m1 = m0;
-    const Positions p = smooth_perturbation(vertices_matrix(m0), a.perturb, a.wavelength, a.seed);
+    const Positions p =
+        research::smooth_perturbation(vertices_matrix(m0), a.perturb, a.wavelength, a.seed);
     for (int i = 0; i < m1.num_vertices(); ++i)
       m1.vertices[i] = p.row(i).transpose();
     fmt::print("t1 = t0 + smooth perturbation (amplitude {}, wavelength {}, seed {})\n", a.perturb,

@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   const int n = static_cast<int>(std::lround(std::sqrt(triangles / 2.0)));
 
-  const ProceduralScene s = crumpled_sheet(n, 7);
+  const research::ProceduralScene s = research::crumpled_sheet(n, 7);
   const double a = 0.8, b = 0.8 + 1.0 / n;
   const Positions x0 = s.v_t0 + a * (s.v_t1 - s.v_t0);
   const Positions x1 = s.v_t0 + b * (s.v_t1 - s.v_t0);

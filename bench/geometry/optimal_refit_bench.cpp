@@ -19,6 +19,7 @@
 #include "clothcd/mesh/io.hpp"
 #include "clothcd/mesh/topology.hpp"
 #include "clothcd/research/procedural.hpp"
+#include "clothcd/research/refit.hpp"
 
 namespace {
 
@@ -49,7 +50,7 @@ const Garment* garment(int which) {
   g = std::make_unique<Garment>();
   g->topology = std::make_unique<Topology>(m.faces, m.num_vertices());
   g->v0 = m.vertices;
-  const Positions p1 = smooth_perturbation(vertices_matrix(m), 0.01, 0.2, 1);
+  const Positions p1 = research::smooth_perturbation(vertices_matrix(m), 0.01, 0.2, 1);
   for (int i = 0; i < m.num_vertices(); ++i)
     g->v1.push_back(p1.row(i).transpose());
   return g.get();
@@ -65,10 +66,10 @@ void refit_bench(benchmark::State& state, bool optimal) {
                               static_cast<std::size_t>(state.range(2)));
   Bvh bvh(*g->topology, g->v0, state.range(1) == 0 ? BvhBuild::Spatial : BvhBuild::Patch);
   RefitOptions o;
-  o.policy = ConePolicy::Proposed;
-  o.optimal_cones = optimal;
+  const research::ConeRule rule =
+      optimal ? research::ConeRule::Optimal : research::ConeRule::Proposed;
   for (auto _ : state) {
-    bvh.refit(g->v0, g->v1, o);
+    research::refit(bvh, g->v0, g->v1, o, rule);
     benchmark::DoNotOptimize(bvh.cones().data());
   }
   double sum = 0;

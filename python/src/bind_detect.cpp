@@ -357,7 +357,7 @@ class PyPairDetector {
   std::optional<PairDetector> det_;
 };
 
-py::tuple scene_tuple(ProceduralScene&& s) {
+py::tuple scene_tuple(research::ProceduralScene&& s) {
   return py::make_tuple(faces_array(std::move(s.faces)), matrix_array(s.v_t0),
                         matrix_array(s.v_t1));
 }
@@ -560,26 +560,27 @@ V_a, V_b: (n, 3) reference positions the trees are split on.)") +
       "Small procedural scenes with one linear motion each (tests, examples): each function "
       "returns (F, V0, V1).");
   proc.def(
-      "stacked_sheets", [](int n) { return scene_tuple(stacked_sheets(n)); }, py::arg("n") = 12,
-      "Two n x n sheets 0.1 apart moving through each other.");
+      "stacked_sheets", [](int n) { return scene_tuple(research::stacked_sheets(n)); },
+      py::arg("n") = 12, "Two n x n sheets 0.1 apart moving through each other.");
   proc.def(
       "winding_strip",
-      [](int segments, int rings) { return scene_tuple(winding_strip(segments, rings)); },
+      [](int segments, int rings) { return scene_tuple(research::winding_strip(segments, rings)); },
       py::arg("segments") = 96, py::arg("rings") = 3,
       "An annular strip over 2 pi + 1 radians whose overlapping ends pass through each other.");
   proc.def(
       "crumpled_sheet",
-      [](int n, std::uint64_t seed) { return scene_tuple(crumpled_sheet(n, seed)); }, py::arg("n"),
-      py::arg("seed"), "An n x n sheet crumpled by a random smooth displacement.");
+      [](int n, std::uint64_t seed) { return scene_tuple(research::crumpled_sheet(n, seed)); },
+      py::arg("n"), py::arg("seed"), "An n x n sheet crumpled by a random smooth displacement.");
   proc.def(
       "twisted_strip",
-      [](int segments, int width) { return scene_tuple(twisted_strip(segments, width)); },
+      [](int segments, int width) { return scene_tuple(research::twisted_strip(segments, width)); },
       py::arg("segments") = 80, py::arg("width") = 4,
       "A strip, twisted and coiled so that its ends cross.");
   proc.def(
       "smooth_perturbation",
       [](const ArrayLike& V, double amplitude, double wavelength, std::uint64_t seed) {
-        return matrix_array(smooth_perturbation(positions(V, "V"), amplitude, wavelength, seed));
+        return matrix_array(
+            research::smooth_perturbation(positions(V, "V"), amplitude, wavelength, seed));
       },
       py::arg("V"), py::arg("amplitude"), py::arg("wavelength"), py::arg("seed"),
       "V plus a smooth displacement field (no coordinate moves more than amplitude).");

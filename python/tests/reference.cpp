@@ -46,14 +46,15 @@ research::DetectOptions options(const Args& a) {
   return o;
 }
 
-ProceduralScene scene(const Args& a) {
+research::ProceduralScene scene(const Args& a) {
   const std::string name = get(a, "scene", "");
-  if (name == "stacked_sheets") return stacked_sheets(get_int(a, "n", 12));
+  if (name == "stacked_sheets") return research::stacked_sheets(get_int(a, "n", 12));
   if (name == "winding_strip")
-    return winding_strip(get_int(a, "segments", 96), get_int(a, "rings", 3));
-  if (name == "crumpled_sheet") return crumpled_sheet(get_int(a, "n", 16), get_int(a, "seed", 1));
+    return research::winding_strip(get_int(a, "segments", 96), get_int(a, "rings", 3));
+  if (name == "crumpled_sheet")
+    return research::crumpled_sheet(get_int(a, "n", 16), get_int(a, "seed", 1));
   if (name == "twisted_strip")
-    return twisted_strip(get_int(a, "segments", 80), get_int(a, "width", 4));
+    return research::twisted_strip(get_int(a, "segments", 80), get_int(a, "width", 4));
   throw std::invalid_argument("unknown scene " + name);
 }
 
@@ -88,14 +89,14 @@ int run(const Args& a) {
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   return arena.execute([&] {
     if (a.count("scene") != 0) {
-      const ProceduralScene s = scene(a);
+      const research::ProceduralScene s = scene(a);
       research::SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
       nlohmann::json j = pairs_json(det.detect(s.v_t0, s.v_t1));
       if (get(a, "oracle", "0") == "1") {
         const Topology topo(s.faces, s.num_vertices);
         clothcd::DetectOptions oo = o;
         oo.culling = Culling::None;
-        j["oracle"] = pairs_json(brute_force_detect(topo, s.v_t0, s.v_t1, oo));
+        j["oracle"] = pairs_json(research::brute_force_detect(topo, s.v_t0, s.v_t1, oo));
       }
       std::cout << j.dump() << '\n';
       return 0;

@@ -48,9 +48,10 @@ void set_box(BvhNode& n, std::initializer_list<const Eigen::Vector3d*> pts) {
 }  // namespace
 
 template <class LeafFn, class PatchFn>
-void Bvh::refit_levels(const RefitOptions& options, std::span<const std::uint8_t> only,
-                       int min_count, LeafFn&& leaf, PatchFn&& patch) {
-  const bool optimal = options.cones && options.optimal_cones;
+void Bvh::refit_levels(const RefitOptions& options, bool optimal_cones,
+                       std::span<const std::uint8_t> only, int min_count, LeafFn&& leaf,
+                       PatchFn&& patch) {
+  const bool optimal = options.cones && optimal_cones;
   // A node below min_count triangles gets a cone only where its parent merges it (from its
   // triangles at once, by `patch`); the nodes below it get none.
   auto child_cone = [&](int c) -> const NormalCone& {
@@ -115,32 +116,51 @@ void Bvh::forget_changes() {
 
 void Bvh::refit(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
                 const RefitOptions& options) {
-  forget_changes();
-  refit_nodes(v_t0, v_t1, options, {});
+  refit_with(v_t0, v_t1, options, false);
 }
-
 void Bvh::refit_changed(std::span<const Eigen::Vector3d> v_t0,
                         std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options) {
-  if (changed_options_ != options) forget_changes();
+  refit_changed_with(v_t0, v_t1, options, false);
+}
+void Bvh::refit_moved(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                      const RefitOptions& options, std::span<const std::uint8_t> moved) {
+  refit_moved_with(v_t0, v_t1, options, moved, false);
+}
+void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options) {
+  refit_static_with(v, options, false);
+}
+
+void Bvh::refit_with(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                     const RefitOptions& options, bool optimal) {
+  forget_changes();
+  refit_nodes(v_t0, v_t1, options, optimal, {});
+}
+
+void Bvh::refit_changed_with(std::span<const Eigen::Vector3d> v_t0,
+                             std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options,
+                             bool optimal) {
+  if (changed_options_ != options || changed_optimal_ != optimal) forget_changes();
   const auto moved = detail::moved_vertices(changed_t0_, changed_t1_, v_t0, v_t1);
-  refit_flagged(v_t0, v_t1, options,
+  refit_flagged(v_t0, v_t1, options, optimal,
                 moved ? std::span<const std::uint8_t>(*moved) : std::span<const std::uint8_t>{});
 }
 
-void Bvh::refit_moved(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
-                      const RefitOptions& options, std::span<const std::uint8_t> moved) {
-  if (changed_options_ != options || moved.size() != static_cast<std::size_t>(num_vertices_)) {
+void Bvh::refit_moved_with(std::span<const Eigen::Vector3d> v_t0,
+                           std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options,
+                           std::span<const std::uint8_t> moved, bool optimal) {
+  if (changed_options_ != options || changed_optimal_ != optimal ||
+      moved.size() != static_cast<std::size_t>(num_vertices_)) {
     moved = {};
   }
   // refit_changed()'s copies are now stale: its next call refits everything and keeps new ones.
   changed_t0_.clear();
   changed_t1_.clear();
-  refit_flagged(v_t0, v_t1, options, moved);
+  refit_flagged(v_t0, v_t1, options, optimal, moved);
 }
 
 void Bvh::refit_flagged(std::span<const Eigen::Vector3d> v_t0,
                         std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options,
-                        std::span<const std::uint8_t> moved) {
+                        bool optimal, std::span<const std::uint8_t> moved) {
   std::vector<std::uint8_t> touched;
   if (!moved.empty()) {
     touched.assign(faces_.size(), 0);
@@ -149,18 +169,19 @@ void Bvh::refit_flagged(std::span<const Eigen::Vector3d> v_t0,
         touched[f] |= moved[v];
     }
   }
-  refit_nodes(v_t0, v_t1, options,
+  refit_nodes(v_t0, v_t1, options, optimal,
               moved.empty() ? std::vector<std::uint8_t>{} : nodes_holding(touched));
   changed_options_ = options;
+  changed_optimal_ = optimal;
 }
 
 void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
-                      const RefitOptions& options, std::span<const std::uint8_t> nodes) {
+                      const RefitOptions& options, bool optimal_cones,
+                      std::span<const std::uint8_t> nodes) {
   const double margin = 0.5 * options.thickness;
   // Optimal cones start from exact leaf caps.
-  const LeafConePolicy lp =
-      options.optimal_cones ? LeafConePolicy::Exact : leaf_policy(options.policy);
-  const bool optimal = options.cones && options.optimal_cones;
+  const LeafConePolicy lp = optimal_cones ? LeafConePolicy::Exact : leaf_policy(options.policy);
+  const bool optimal = options.cones && optimal_cones;
   const auto& faces = faces_;
   // Optimal cones need every leaf's control directions.
   const int min_count = optimal ? 0 : options.cone_min_triangles;
@@ -191,13 +212,14 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
       if (bad) cones_[i] = full_cone();
     }
   };
-  refit_levels(options, nodes, min_count, leaf, patch);
+  refit_levels(options, optimal_cones, nodes, min_count, leaf, patch);
 }
 
-void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options) {
+void Bvh::refit_static_with(std::span<const Eigen::Vector3d> v, const RefitOptions& options,
+                            bool optimal_cones) {
   forget_changes();
   const double margin = 0.5 * options.thickness;
-  const bool optimal = options.cones && options.optimal_cones;
+  const bool optimal = options.cones && optimal_cones;
   auto leaf = [&](BvhNode& n, int i) {
     const Face& t = prim_faces_[n.first];
     const Eigen::Vector3d &a = v[t[0]], &b = v[t[1]], &c = v[t[2]];
@@ -215,7 +237,7 @@ void Bvh::refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options)
     }
   };
   // Static cones are cheap and rarely used: every node gets one.
-  refit_levels(options, {}, 0, leaf, [](int) { return full_cone(); });
+  refit_levels(options, optimal_cones, {}, 0, leaf, [](int) { return full_cone(); });
 }
 
 double Bvh::box_area_ratio() const {

@@ -59,16 +59,16 @@ Points ends(const EdgeEdgeQuery& q, bool t1) {
             : Points{q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0};
 }
 double distance(const VertexFaceQuery&, const Points& p) {
-  return detail::point_triangle_closest(p[0], p[1], p[2], p[3]).distance;
+  return ccd_detail::point_triangle_closest(p[0], p[1], p[2], p[3]).distance;
 }
 double distance(const EdgeEdgeQuery&, const Points& p) {
-  return detail::edge_edge_closest(p[0], p[1], p[2], p[3]).distance;
+  return ccd_detail::edge_edge_closest(p[0], p[1], p[2], p[3]).distance;
 }
 double lower_bound(const VertexFaceQuery&, const Points& p) {
-  return detail::point_triangle_bound(p[0], p[1], p[2], p[3]);
+  return ccd_detail::point_triangle_bound(p[0], p[1], p[2], p[3]);
 }
 double lower_bound(const EdgeEdgeQuery&, const Points& p) {
-  return detail::edge_edge_bound(p[0], p[1], p[2], p[3]);
+  return ccd_detail::edge_edge_bound(p[0], p[1], p[2], p[3]);
 }
 double move(const VertexFaceQuery& q) {
   return largest_relative_move({q.v_t1 - q.v_t0},
@@ -88,8 +88,8 @@ bool filter_culls(const Query& q, double thickness, int depth) {
     }
   }
   const double m = move(q);
-  const double eps =
-      detail::coordinate_slack({&p0[0], &p0[1], &p0[2], &p0[3], &p1[0], &p1[1], &p1[2], &p1[3]});
+  const double eps = ccd_detail::coordinate_slack(
+      {&p0[0], &p0[1], &p0[2], &p0[3], &p1[0], &p1[1], &p1[2], &p1[3]});
   // Lower bounds first: where they cull, the distances would too (the bound grows with them).
   if (culls(lower_bound(q, p0), lower_bound(q, p1), m, thickness, eps)) return true;
   return culls_on(0.0, 1.0, distance(q, p0), distance(q, p1), m, thickness, eps, depth,
@@ -116,7 +116,7 @@ bool distance_filter_culls(const TriangleTriangleQuery& q, double thickness) {
                         &q.a1_t1, &q.a2_t1, &q.b0_t1, &q.b1_t1, &q.b2_t1}) {
     if (!x->allFinite()) throw std::invalid_argument("distance_filter_culls: non-finite input");
   }
-  return detail::triangles_filter_culls(
+  return ccd_detail::triangles_filter_culls(
       {&q.a0_t0, &q.a1_t0, &q.a2_t0}, {&q.a0_t1, &q.a1_t1, &q.a2_t1},
       {&q.b0_t0, &q.b1_t0, &q.b2_t0}, {&q.b0_t1, &q.b1_t1, &q.b2_t1}, thickness);
 }

@@ -7,7 +7,7 @@
 
 #include "clothcd/ccd/proximity.hpp"
 
-namespace clothcd::detail {
+namespace clothcd::ccd_detail {
 
 [[nodiscard]] PointTriangleProximity point_triangle_closest(const Eigen::Vector3d& p,
                                                             const Eigen::Vector3d& f0,
@@ -31,4 +31,4 @@ namespace clothcd::detail {
                                       const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1,
                                       double limit);
 
-}  // namespace clothcd::detail
+}  // namespace clothcd::ccd_detail

@@ -4,7 +4,7 @@
 
 #include "ccd/isa.hpp"
 
-namespace clothcd::detail {
+namespace clothcd::ccd_detail {
 
 #if CLOTHCD_NP_BATCH_X86
 void triangles_filter_batch_sse2(const FacePairBatch& b, double thickness, bool* culls,
@@ -59,20 +59,20 @@ constexpr void (*const kBound[4])(const StaticFacePairBatch&, double*) = {
 
 void triangles_filter_batch(const FacePairBatch& b, double thickness, bool* culls,
                             double* bound_t1) {
-  ccd_detail::run_on(-1, kFilter, b, thickness, culls, bound_t1);
+  run_on(-1, kFilter, b, thickness, culls, bound_t1);
 }
 
 bool triangles_filter_batch_with(int isa, const FacePairBatch& b, double thickness, bool* culls,
                                  double* bound_t1) {
-  return isa >= 0 && ccd_detail::run_on(isa, kFilter, b, thickness, culls, bound_t1);
+  return isa >= 0 && run_on(isa, kFilter, b, thickness, culls, bound_t1);
 }
 
 void triangle_bound_batch(const StaticFacePairBatch& b, double* bound) {
-  ccd_detail::run_on(-1, kBound, b, bound);
+  run_on(-1, kBound, b, bound);
 }
 
 bool triangle_bound_batch_with(int isa, const StaticFacePairBatch& b, double* bound) {
-  return isa >= 0 && ccd_detail::run_on(isa, kBound, b, bound);
+  return isa >= 0 && run_on(isa, kBound, b, bound);
 }
 
-}  // namespace clothcd::detail
+}  // namespace clothcd::ccd_detail

@@ -8,7 +8,7 @@
 
 #include "ccd/face_bounds.hpp"
 
-namespace clothcd::detail {
+namespace clothcd::ccd_detail {
 
 /// Up to kCapacity entries of `Triangles` triangles each, gathered coordinate by coordinate for the
 /// batched filters: coordinate c (0..2) of point p of entry i is x[3 * p + c][i], the points
@@ -58,4 +58,4 @@ void triangle_bound_batch(const StaticFacePairBatch& b, double* bound);
 /// The same with a fixed instruction set, for tests (as triangles_filter_batch_with).
 bool triangle_bound_batch_with(int isa, const StaticFacePairBatch& b, double* bound);
 
-}  // namespace clothcd::detail
+}  // namespace clothcd::ccd_detail

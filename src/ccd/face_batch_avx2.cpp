@@ -3,7 +3,7 @@
 #define FACE_BOUNDS_NAMESPACE avx2_impl
 #include "ccd/face_batch_impl.hpp"
 
-namespace clothcd::detail {
+namespace clothcd::ccd_detail {
 
 void triangles_filter_batch_avx2(const FacePairBatch& b, double thickness, bool* culls,
                                  double* bound_t1) {
@@ -14,4 +14,4 @@ void triangle_bound_batch_avx2(const StaticFacePairBatch& b, double* bound) {
   avx2_impl::triangle_bound_batch_impl<xsimd::avx2>(b, bound);
 }
 
-}  // namespace clothcd::detail
+}  // namespace clothcd::ccd_detail

@@ -4,7 +4,7 @@
 #define FACE_BOUNDS_NAMESPACE avx512_impl
 #include "ccd/face_batch_impl.hpp"
 
-namespace clothcd::detail {
+namespace clothcd::ccd_detail {
 
 void triangles_filter_batch_avx512(const FacePairBatch& b, double thickness, bool* culls,
                                    double* bound_t1) {
@@ -15,4 +15,4 @@ void triangle_bound_batch_avx512(const StaticFacePairBatch& b, double* bound) {
   avx512_impl::triangle_bound_batch_impl<xsimd::avx512f>(b, bound);
 }
 
-}  // namespace clothcd::detail
+}  // namespace clothcd::ccd_detail

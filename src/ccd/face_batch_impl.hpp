@@ -10,7 +10,7 @@
 #include "ccd/face_batch.hpp"
 #include "ccd/face_bounds_impl.hpp"
 
-namespace clothcd::detail::FACE_BOUNDS_NAMESPACE {
+namespace clothcd::ccd_detail::FACE_BOUNDS_NAMESPACE {
 
 // Point p of the entries i..i + B::size - 1 of a batch.
 template <class B, int Triangles>
@@ -59,4 +59,4 @@ void triangle_bound_batch_impl(const StaticFacePairBatch& b, double* bound) {
   }
 }
 
-}  // namespace clothcd::detail::FACE_BOUNDS_NAMESPACE
+}  // namespace clothcd::ccd_detail::FACE_BOUNDS_NAMESPACE

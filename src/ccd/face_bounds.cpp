@@ -5,7 +5,7 @@
 #define FACE_BOUNDS_NAMESPACE scalar_impl
 #include "ccd/face_bounds_impl.hpp"
 
-namespace clothcd::detail {
+namespace clothcd::ccd_detail {
 namespace {
 
 using P = scalar_impl::P3<double>;
@@ -38,4 +38,4 @@ bool triangles_filter_culls(const Triangle& a_t0, const Triangle& a_t1, const Tr
   return culls;
 }
 
-}  // namespace clothcd::detail
+}  // namespace clothcd::ccd_detail

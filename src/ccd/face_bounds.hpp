@@ -8,7 +8,7 @@
 #include <array>
 #include <span>
 
-namespace clothcd::detail {
+namespace clothcd::ccd_detail {
 
 using Triangle = std::array<const Eigen::Vector3d*, 3>;
 
@@ -34,4 +34,4 @@ inline Triangle corners(std::span<const Eigen::Vector3d> x, const std::array<int
                                           const Triangle& b_t0, const Triangle& b_t1,
                                           double thickness, double* bound_t1 = nullptr);
 
-}  // namespace clothcd::detail
+}  // namespace clothcd::ccd_detail

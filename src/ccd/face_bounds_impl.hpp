@@ -13,18 +13,18 @@
 
 #include "ccd/lanes.hpp"
 
-namespace clothcd::detail {
+namespace clothcd::ccd_detail {
 namespace FACE_BOUNDS_NAMESPACE {
 
 // The 3-vector of lanes and its operations (lanes.hpp).
 template <class T>
-using P3 = ccd_detail::lanes::Vec3<T>;
-using ccd_detail::lanes::cross;
-using ccd_detail::lanes::dot;
-using ccd_detail::lanes::max_of;
-using ccd_detail::lanes::min_of;
-using ccd_detail::lanes::select;
-using ccd_detail::lanes::sub;
+using P3 = lanes::Vec3<T>;
+using lanes::cross;
+using lanes::dot;
+using lanes::max_of;
+using lanes::min_of;
+using lanes::select;
+using lanes::sub;
 
 template <class T>
 P3<T> min_of(const P3<T>& p, const P3<T>& q) {
@@ -125,4 +125,4 @@ template <class T>
 }
 
 }  // namespace FACE_BOUNDS_NAMESPACE
-}  // namespace clothcd::detail
+}  // namespace clothcd::ccd_detail

@@ -14,10 +14,9 @@ constexpr int kMaxLevel = kFastPathMaxLevel;
 // Ranges examined (with the inside test) per query; past it the inclusion solver takes the rest of
 // the step. Bounds the cost of flat cubics (near-coplanar motion) whose sign is never certain.
 constexpr int kBudget = kFastPathBudget;
-// The inside test (~45 ns) starts at kFirstInsideLevel: the cubic's own halving (~5 ns) first
-// discards the quarters of the step without a root. On cloth_ball 92 -> 93 depth 2 halves the
-// inside tests (7.7 M -> 4.4 M for 2.3 M queries); deeper starts cost more on near-coplanar (flat)
-// cubics.
+// The inside test (several times the cost of a halving) starts at kFirstInsideLevel: the cubic's
+// own halving first discards the quarters of the step without a root, which spares most inside
+// tests; deeper starts cost more on near-coplanar (flat) cubics.
 // Subdivision error bounds hold to this depth.
 constexpr int kMaxRefine = 40;
 

@@ -53,8 +53,8 @@ bool distance_filter_batch_with(int isa, Kind kind, const NpBatch& b, double thi
                                 NpVerdict* verdict);
 
 /// The depth (ranges of 2^-kSettleLevel of the step) to which fast_path_settle follows the
-/// search. On cloth_ball 92 -> 93, of 2.23 M kept queries (113,855 hits), 35 K are left over at
-/// depth 6 (247 K at depth 4, counting misses only); each costs the scalar kernel's whole search.
+/// search. A query left over costs the scalar kernel's whole search, and a shallower level leaves
+/// many more of them (docs/results/detect_profile.md gives the settle's share of a detection).
 inline constexpr int kSettleLevel = 6;
 
 /// What fast_path_settle finds of a query: the zero-thickness kernel's own answer (fast path on,

@@ -211,7 +211,7 @@ struct SettleScratch {
 // lane repeating the scalar code (the sources named at each step). Scaling, the cubic and the
 // first levels of halving run on W queries at a time; the inside tests, the bulk of the work, on
 // W time ranges at a time, gathered from all queries of the batch (a range's lanes are rarely
-// full otherwise: 1.4 of 4 on cloth_ball). `target`: toi_target_level.
+// full otherwise). `target`: toi_target_level.
 template <class Arch>
 void fast_path_settle_impl(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
                            FastSettled* settled, double* toi) {

@@ -56,7 +56,7 @@ double along_normal(const Eigen::Vector3d& u, const Eigen::Vector3d& v, const Ei
 
 }  // namespace
 
-namespace detail {
+namespace ccd_detail {
 
 // The lower bounds less their rounding allowance, input already checked.
 double point_triangle_bound(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
@@ -168,18 +168,18 @@ double edge_edge_within(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
   return bound > limit ? bound : edge_edge_closest(ea0, ea1, eb0, eb1).distance;
 }
 
-}  // namespace detail
+}  // namespace ccd_detail
 
 double point_triangle_distance_lower_bound(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
                                            const Eigen::Vector3d& f1, const Eigen::Vector3d& f2) {
   require_finite({&p, &f0, &f1, &f2}, "point_triangle_distance_lower_bound");
-  return detail::point_triangle_bound(p, f0, f1, f2);
+  return ccd_detail::point_triangle_bound(p, f0, f1, f2);
 }
 
 double edge_edge_distance_lower_bound(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
                                       const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
   require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_distance_lower_bound");
-  return detail::edge_edge_bound(ea0, ea1, eb0, eb1);
+  return ccd_detail::edge_edge_bound(ea0, ea1, eb0, eb1);
 }
 
 double triangle_triangle_distance_lower_bound(const Eigen::Vector3d& a0, const Eigen::Vector3d& a1,
@@ -187,21 +187,21 @@ double triangle_triangle_distance_lower_bound(const Eigen::Vector3d& a0, const E
                                               const Eigen::Vector3d& b1,
                                               const Eigen::Vector3d& b2) {
   require_finite({&a0, &a1, &a2, &b0, &b1, &b2}, "triangle_triangle_distance_lower_bound");
-  return detail::triangle_triangle_bound({&a0, &a1, &a2}, {&b0, &b1, &b2});
+  return ccd_detail::triangle_triangle_bound({&a0, &a1, &a2}, {&b0, &b1, &b2});
 }
 
 double point_triangle_distance_if_within(const Eigen::Vector3d& p, const Eigen::Vector3d& f0,
                                          const Eigen::Vector3d& f1, const Eigen::Vector3d& f2,
                                          double limit) {
   require_finite({&p, &f0, &f1, &f2}, "point_triangle_distance_if_within");
-  return detail::point_triangle_within(p, f0, f1, f2, limit);
+  return ccd_detail::point_triangle_within(p, f0, f1, f2, limit);
 }
 
 double edge_edge_distance_if_within(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
                                     const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1,
                                     double limit) {
   require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_distance_if_within");
-  return detail::edge_edge_within(ea0, ea1, eb0, eb1, limit);
+  return ccd_detail::edge_edge_within(ea0, ea1, eb0, eb1, limit);
 }
 
 double point_segment_parameter(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
@@ -216,13 +216,13 @@ PointTriangleProximity point_triangle_proximity(const Eigen::Vector3d& p, const 
                                                 const Eigen::Vector3d& f1,
                                                 const Eigen::Vector3d& f2) {
   require_finite({&p, &f0, &f1, &f2}, "point_triangle_proximity");
-  return detail::point_triangle_closest(p, f0, f1, f2);
+  return ccd_detail::point_triangle_closest(p, f0, f1, f2);
 }
 
 EdgeEdgeProximity edge_edge_proximity(const Eigen::Vector3d& ea0, const Eigen::Vector3d& ea1,
                                       const Eigen::Vector3d& eb0, const Eigen::Vector3d& eb1) {
   require_finite({&ea0, &ea1, &eb0, &eb1}, "edge_edge_proximity");
-  return detail::edge_edge_closest(ea0, ea1, eb0, eb1);
+  return ccd_detail::edge_edge_closest(ea0, ea1, eb0, eb1);
 }
 
 }  // namespace clothcd

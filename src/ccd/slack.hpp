@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <initializer_list>
 
-namespace clothcd::detail {
+namespace clothcd::ccd_detail {
 
 inline double coordinate_slack(std::initializer_list<const Eigen::Vector3d*> points) {
   double m = 1.0;
@@ -17,4 +17,4 @@ inline double coordinate_slack(std::initializer_list<const Eigen::Vector3d*> poi
   return 1e-12 * m;
 }
 
-}  // namespace clothcd::detail
+}  // namespace clothcd::ccd_detail

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <string_view>
 
+#include "bvh/optimal_cones.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/names.hpp"
 #include "detect/options.hpp"
@@ -67,10 +68,14 @@ void SelfCore::refit(DetectStats& st) {
   ro.thickness = box_reach();
   ro.cones = cones_used(rule());
   ro.policy = opt.policy;
-  ro.optimal_cones = optimal_cones;
   // The unsound rules are measured on every node.
   if (rule() == Rule::Sound) ro.cone_min_triangles = opt.cull_min_triangles;
-  bvh.refit_moved(v0, v1, ro, step.changed_since(bvh_call));
+  const auto moved = step.changed_since(bvh_call);
+  if (optimal_cones) {
+    OptimalCones::refit_moved(bvh, v0, v1, ro, moved);
+  } else {
+    bvh.refit_moved(v0, v1, ro, moved);
+  }
   bvh_call = step.call();
   st.time_refit = seconds_since(t);
   st.internal_nodes = bvh.num_internal();

@@ -27,7 +27,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "ccd/refine.hpp"
+#include "ccd/batch.hpp"
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/mesh/topology.hpp"

@@ -23,9 +23,7 @@
 #include <emmintrin.h>
 #endif
 
-#include "ccd/face_batch.hpp"
-#include "ccd/face_bounds.hpp"
-#include "ccd/np_batch.hpp"
+#include "ccd/batch.hpp"
 #include "clothcd/bvh/aabb.hpp"
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/core/error.hpp"
@@ -103,8 +101,8 @@ Query query_at(const ccd_detail::NpBatch& b, int i) {
 /// the scalar verdicts and bounds bit for bit); one per thread. `slot[k]`: where the caller's
 /// k-th pair of a piece went (-1: not queued).
 struct FacesApartBatch {
-  static constexpr int kCapacity = FacePairBatch::kCapacity;
-  FacePairBatch pairs;
+  static constexpr int kCapacity = ccd_detail::FacePairBatch::kCapacity;
+  ccd_detail::FacePairBatch pairs;
   std::array<bool, kCapacity> apart{};
   std::array<double, kCapacity> bound_t1{};
   std::array<int, kCapacity> slot{};
@@ -113,12 +111,13 @@ struct FacesApartBatch {
   int push(std::span<const Eigen::Vector3d> a0, std::span<const Eigen::Vector3d> a1, const Face& a,
            std::span<const Eigen::Vector3d> b0, std::span<const Eigen::Vector3d> b1,
            const Face& b) {
+    using ccd_detail::corners;
     pairs.push(corners(a0, a), corners(a1, a), corners(b0, b), corners(b1, b));
     return pairs.size - 1;
   }
   /// Filters the queued pairs at `thickness` into apart and bound_t1, and empties the queue.
   void run(double thickness) {
-    triangles_filter_batch(pairs, thickness, apart.data(), bound_t1.data());
+    ccd_detail::triangles_filter_batch(pairs, thickness, apart.data(), bound_t1.data());
     pairs.size = 0;
   }
 };
@@ -127,20 +126,20 @@ struct FacesApartBatch {
 /// (triangle_triangle_bound), which `run` computes for a batch at a time, vectorised
 /// (face_batch.hpp, bit for bit); one per thread. `slot` as in FacesApartBatch.
 struct FaceBoundBatch {
-  static constexpr int kCapacity = StaticFacePairBatch::kCapacity;
-  StaticFacePairBatch pairs;
+  static constexpr int kCapacity = ccd_detail::StaticFacePairBatch::kCapacity;
+  ccd_detail::StaticFacePairBatch pairs;
   std::array<double, kCapacity> bound{};
   std::array<int, kCapacity> slot{};
 
   /// Queues face a (positions x) against face b (positions y); returns its slot.
   int push(std::span<const Eigen::Vector3d> x, const Face& a, std::span<const Eigen::Vector3d> y,
            const Face& b) {
-    pairs.push(corners(x, a), corners(y, b));
+    pairs.push(ccd_detail::corners(x, a), ccd_detail::corners(y, b));
     return pairs.size - 1;
   }
   /// Bounds the queued pairs into `bound`, and empties the queue.
   void run() {
-    triangle_bound_batch(pairs, bound.data());
+    ccd_detail::triangle_bound_batch(pairs, bound.data());
     pairs.size = 0;
   }
 };

@@ -10,8 +10,8 @@ namespace clothcd::detail {
 /// recomputes only the boxes of features with a vertex whose positions (t0 or t1) changed since
 /// the last update with the same margin. A box depends on nothing else, so the result is the same
 /// as recomputing all of them; a restricted CCD pass, in which a few hundred vertices of the
-/// cloth changed their motion, then pays for those alone (the full recomputation was 90% of such
-/// a pass on multilayer-rumba).
+/// cloth changed their motion, then pays for those alone (the full recomputation would be most
+/// of such a pass).
 class FeatureBoxes {
  public:
   /// `face_blocks`: also keep each face's boxes gathered as a FaceBoxes (FeatureContext::

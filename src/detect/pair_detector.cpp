@@ -10,17 +10,17 @@
 #include <cmath>
 #include <string_view>
 
-#include "ccd/distances.hpp"
+#include "bvh/front.hpp"
+#include "bvh/traversal.hpp"
+#include "ccd/batch.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
 #include "earliest.hpp"
-#include "front.hpp"
 #include "narrow.hpp"
 #include "options.hpp"
 #include "pair_results.hpp"
 #include "positions.hpp"
-#include "traversal.hpp"
 
 namespace clothcd {
 namespace {
@@ -441,19 +441,19 @@ struct PairDetector::Impl {
                 [&](int v, int k) {
                   const Face& t = faces_b[k];
                   const double d =
-                      detail::point_triangle_within(xa[v], xb[t[0]], xb[t[1]], xb[t[2]], h);
+                      ccd_detail::point_triangle_within(xa[v], xb[t[0]], xb[t[1]], xb[t[2]], h);
                   if (d <= h) out.ab.push_back({v, k, d});
                 },
                 [&](int u, int k) {
                   const Face& t = faces_a[k];
                   const double d =
-                      detail::point_triangle_within(xb[u], xa[t[0]], xa[t[1]], xa[t[2]], h);
+                      ccd_detail::point_triangle_within(xb[u], xa[t[0]], xa[t[1]], xa[t[2]], h);
                   if (d <= h) out.ba.push_back({u, k, d});
                 },
                 [&](int x, int y) {
                   const Edge &p = edges_a[x], &q = edges_b[y];
                   const double d =
-                      detail::edge_edge_within(xa[p[0]], xa[p[1]], xb[q[0]], xb[q[1]], h);
+                      ccd_detail::edge_edge_within(xa[p[0]], xa[p[1]], xb[q[0]], xb[q[1]], h);
                   if (d <= h) out.ee.push_back({x, y, d});
                 });
           }

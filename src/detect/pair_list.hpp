@@ -1,7 +1,7 @@
 #pragma once
 // The triangle pairs the traversal hands to the narrow phase, stored per thread in blocks.
 //
-// Why blocks: one step of a large mesh finds millions of pairs (cloth_ball: 3.9 M, 31 MB). A
+// Why blocks: one step of a large mesh finds millions of pairs (docs/detect.md, What it costs). A
 // growing vector copies them at every doubling and touches about twice that memory, and merging
 // the threads' vectors into one copies them again. Fresh memory is dear (each page is faulted in
 // and zeroed), so the blocks are never moved, the narrow phase reads them where they are, and a

@@ -18,13 +18,13 @@
 #include <emmintrin.h>
 #endif
 
+#include "bvh/front.hpp"
+#include "bvh/traversal.hpp"
 #include "clothcd/detect/detector.hpp"
-#include "detect/front.hpp"
 #include "detect/narrow.hpp"
 #include "detect/orphans.hpp"
 #include "detect/pair_list.hpp"
 #include "detect/positions.hpp"
-#include "detect/traversal.hpp"
 
 namespace clothcd::detail {
 

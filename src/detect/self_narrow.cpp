@@ -44,9 +44,9 @@ void SelfCore::narrow_pairs(const detail::FeatureContext& ctx, const detail::Pai
   // Without the whole-triangle bound (faces_apart_filter), pair i of the list, faces f and g.
   const auto one = [&](std::size_t i, int f, int g, NarrowBuffer& out) {
     if (near != nullptr) {
-      (*near)[i] =
-          !(detail::triangle_triangle_bound(detail::corners(v1, faces[f]),
-                                            detail::corners(v1, faces[g])) > opt.reuse_distance);
+      (*near)[i] = !(ccd_detail::triangle_triangle_bound(ccd_detail::corners(v1, faces[f]),
+                                                         ccd_detail::corners(v1, faces[g])) >
+                     opt.reuse_distance);
     }
     // Widened leaf boxes: no feature pair of faces whose own boxes miss.
     if (wide && !ctx.face_boxes[f].face_overlaps(ctx.face_boxes[g])) return;

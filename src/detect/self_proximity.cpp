@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "ccd/distances.hpp"
+#include "ccd/batch.hpp"
 #include "detect/self_core.hpp"
 
 namespace clothcd::detail {
@@ -34,12 +34,12 @@ ProximityResult SelfCore::proximity(detail::PointsIn p, double h) {
   // Linked pairs are left out as detect() leaves them out (DetectOptions::linked_vertices).
   auto kvf = [&](int v, int f, const Face& t, Buffer& out) {
     if (!ctx.links.empty() && ctx.vf_linked(v, f)) return;
-    const double d = detail::point_triangle_within(v0[v], v0[t[0]], v0[t[1]], v0[t[2]], h);
+    const double d = ccd_detail::point_triangle_within(v0[v], v0[t[0]], v0[t[1]], v0[t[2]], h);
     if (d <= h) out.vf.push_back({v, f, d});
   };
   auto kee = [&](int a, int b, const Edge& ea, const Edge& eb, Buffer& out) {
     if (!ctx.links.empty() && ctx.ee_linked(a, b)) return;
-    const double d = detail::edge_edge_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
+    const double d = ccd_detail::edge_edge_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
     if (d <= h) out.ee.push_back({a, b, d});
   };
   // A piece at a time: the box test, the whole triangles' bound of the pairs past it at once

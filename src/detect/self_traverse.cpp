@@ -34,7 +34,7 @@ bool SelfCore::corners_clear(const BvhNode& n, double cosine, double reach) cons
   const auto& faces = topo.faces();
   for (int k = n.first; k < n.first + n.count; ++k) {
     const Face& f = faces[prims[k]];
-    const auto x0 = detail::corners(v0, f), x1 = detail::corners(v1, f);
+    const auto x0 = ccd_detail::corners(v0, f), x1 = ccd_detail::corners(v1, f);
     if (cosine * detail::triangle_corner_clearance_bound(x0, x1) > reach) continue;
     if (!(cosine * detail::triangle_corner_clearance(x0, x1) > reach)) return false;
   }

@@ -19,6 +19,7 @@
 #include "clothcd/core/error.hpp"
 #include "clothcd/experiment/experiment.hpp"
 #include "clothcd/research/detector.hpp"
+#include "clothcd/research/refit.hpp"
 #include "records.hpp"
 
 namespace clothcd::experiment {
@@ -140,10 +141,8 @@ std::vector<SpreadRow> spreads(const Sequence& seq, BvhBuild build, int step, Bv
   std::vector<char> domain;
   std::vector<SpreadRow> out;
   for (ConeRule p : all) {
-    RefitOptions ro;
-    research::set_cone_rule(ro, p);
     const auto t = std::chrono::steady_clock::now();
-    bvh.refit(v0, v1, ro);
+    research::refit(bvh, v0, v1, RefitOptions{}, p);
     const double ms =
         1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
     const auto& cones = bvh.cones();

@@ -98,7 +98,7 @@ Positions to_positions(const std::vector<Eigen::Vector3d>& x) {
   return p;
 }
 
-Sequence one_step(const ProceduralScene& s) {
+Sequence one_step(const research::ProceduralScene& s) {
   Sequence q;
   q.name = s.name;
   q.source = "procedural: " + s.name + " (clothcd/research/procedural.hpp, one step)";
@@ -253,10 +253,10 @@ std::vector<std::string> procedural_names() {
 
 Sequence procedural_sequence(const std::string& name) {
   if (name == "fold") return folding_sheet(40, 12);
-  if (name == "stacked_sheets") return one_step(stacked_sheets());
-  if (name == "winding_strip") return one_step(winding_strip());
-  if (name == "crumpled_sheet") return one_step(crumpled_sheet(48, 7));
-  if (name == "twisted_strip") return one_step(twisted_strip());
+  if (name == "stacked_sheets") return one_step(research::stacked_sheets());
+  if (name == "winding_strip") return one_step(research::winding_strip());
+  if (name == "crumpled_sheet") return one_step(research::crumpled_sheet(48, 7));
+  if (name == "twisted_strip") return one_step(research::twisted_strip());
   std::string names;
   for (const auto& n : procedural_names())
     names += (names.empty() ? "" : ", ") + n;

@@ -92,7 +92,7 @@ std::vector<clothcd::DetectResult> detect_each_on(detail::SelfCore& m, detail::P
     o.culling = {};
     o.build = {};
     o.cull_min_triangles = 0;
-    o.research.unsound_culling = {};
+    o.research.culling.reset();
     o.research.optimal_cones = false;
     return o;
   };

@@ -13,7 +13,7 @@
 namespace clothcd::research {
 
 void check_research(const DetectOptions& o) {
-  if (o.reuse_distance > 0 && o.research.unsound_culling != UnsoundCulling::None) {
+  if (o.reuse_distance > 0 && unsound(culling_rule(o))) {
     throw InputError(
         "reuse distance: the unsound culling rules may cull the pairs it keeps; use culling none "
         "or sound with it");

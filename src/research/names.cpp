@@ -24,22 +24,14 @@ constexpr Table<CullingRule, 4> kCullingRules{{{CullingRule::None, "none"},
 }  // namespace
 
 CullingRule culling_rule(const DetectOptions& options) {
-  switch (options.research.unsound_culling) {
-    case UnsoundCulling::Cone:
-      return CullingRule::Cone;
-    case UnsoundCulling::Gated:
-      return CullingRule::Gated;
-    case UnsoundCulling::None:
-      break;
-  }
+  if (options.research.culling) return *options.research.culling;
   return options.culling == Culling::Sound ? CullingRule::Sound : CullingRule::None;
 }
 
 void set_culling_rule(DetectOptions& options, CullingRule rule) {
   options.culling = rule == CullingRule::Sound ? Culling::Sound : Culling::None;
-  options.research.unsound_culling = rule == CullingRule::Cone    ? UnsoundCulling::Cone
-                                     : rule == CullingRule::Gated ? UnsoundCulling::Gated
-                                                                  : UnsoundCulling::None;
+  options.research.culling.reset();
+  if (unsound(rule)) options.research.culling = rule;
 }
 
 namespace {
@@ -69,9 +61,6 @@ ConeRule cone_rule(const DetectOptions& options) {
 }
 void set_cone_rule(DetectOptions& options, ConeRule rule) {
   set_rule(options.policy, options.research.optimal_cones, rule);
-}
-void set_cone_rule(RefitOptions& options, ConeRule rule) {
-  set_rule(options.policy, options.optimal_cones, rule);
 }
 
 std::string_view to_string(CullingRule rule) {

@@ -11,7 +11,7 @@
 #include "detect/pair_results.hpp"
 #include "detect/positions.hpp"
 
-namespace clothcd {
+namespace clothcd::research {
 namespace {
 
 struct Buffer {
@@ -47,9 +47,9 @@ bool ee_hit(const detail::FeatureContext& ca, int ea, const detail::FeatureConte
 
 }  // namespace
 
-DetectResult brute_force_detect(const Topology& topo, const Positions& p0, const Positions& p1,
-                                const DetectOptions& options,
-                                std::span<const std::uint8_t> active) {
+clothcd::DetectResult brute_force_detect(const Topology& topo, const Positions& p0,
+                                         const Positions& p1, const clothcd::DetectOptions& options,
+                                         std::span<const std::uint8_t> active) {
   std::vector<Eigen::Vector3d> v0, v1;
   detail::to_points(p0, topo.num_vertices(), "positions at t0", v0);
   detail::to_points(p1, topo.num_vertices(), "positions at t1", v1);
@@ -92,7 +92,7 @@ DetectResult brute_force_detect(const Topology& topo, const Positions& p0, const
       ctx.kernel_ee(ea, eb, out.c, out.ee);
     }
   });
-  DetectResult res;
+  clothcd::DetectResult res;
   for (const auto& l : locals) {
     l.c.add_to(res.stats);
     res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
@@ -108,7 +108,7 @@ DetectResult brute_force_detect(const Topology& topo, const Positions& p0, const
 PairDetectResult brute_force_detect_pair(const Topology& a, const Positions& a_t0,
                                          const Positions& a_t1, const Topology& b,
                                          const Positions& b_t0, const Positions& b_t1,
-                                         const DetectOptions& options) {
+                                         const clothcd::DetectOptions& options) {
   std::vector<Eigen::Vector3d> a0, a1, b0, b1;
   detail::to_points(a_t0, a.num_vertices(), "mesh A at t0", a0);
   detail::to_points(a_t1, a.num_vertices(), "mesh A at t1", a1);
@@ -147,4 +147,4 @@ PairDetectResult brute_force_detect_pair(const Topology& a, const Positions& a_t
   return detail::collect_pair_results(locals);
 }
 
-}  // namespace clothcd
+}  // namespace clothcd::research

@@ -11,7 +11,7 @@
 
 #include "clothcd/core/error.hpp"
 
-namespace clothcd {
+namespace clothcd::research {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -198,4 +198,4 @@ Positions smooth_perturbation(const Positions& positions, double amplitude, doub
   return out;
 }
 
-}  // namespace clothcd
+}  // namespace clothcd::research

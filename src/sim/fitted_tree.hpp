@@ -1,8 +1,7 @@
 #pragma once
 // A box-only BVH kept fit to a deforming mesh. A clothcd BVH is built once and refit; refit to
-// shapes far from the build's, its boxes loosen and every query visits more node pairs (the
-// multilayer garment's intersection count on the kick: 92 ms at frame 90 with the tree built at
-// frame 0, 46 ms rebuilt there). This one is built afresh from the current shape when the refit
+// shapes far from the build's, its boxes loosen and every query visits more node pairs
+// (docs/simulator.md 3.6). This one is built afresh from the current shape when the refit
 // boxes have loosened kLooser times past their fit at the last build (Bvh::box_area_ratio()).
 // What a query finds does not depend on the tree, only how long it takes.
 

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <optional>
 
+#include "bvh/traversal.hpp"
 #include "clothcd/bvh/bvh.hpp"
-#include "detect/traversal.hpp"
 #include "fitted_tree.hpp"
 #include "seam_links.hpp"
 

@@ -15,7 +15,7 @@ using Vecs = std::vector<Vec3>;
 
 /// Symmetric block matrix in CSR form (both triangles stored). Blocks that are a constant
 /// multiple of the identity (only bending and stitch terms reach them, as between the vertices
-/// opposite a hinge: 45% of the multilayer's blocks) may be kept apart as one scalar each, so
+/// opposite a hinge: a large share of a garment's blocks) may be kept apart as one scalar each, so
 /// that a product reads 8 bytes for them instead of 72.
 struct BlockCsr {
   std::vector<int> row_start;  ///< size n + 1

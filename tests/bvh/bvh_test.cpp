@@ -11,6 +11,7 @@
 #include <random>
 #include <set>
 
+#include "bvh/optimal_cones.hpp"
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/research/procedural.hpp"
 #include "support/random_gen.hpp"
@@ -39,8 +40,8 @@ bool connected_brute(const Topology& t, const std::vector<int>& faces) {
 }
 
 TEST(Bvh, StructureAndFlagsMatchBruteForce) {
-  for (const auto& s :
-       {stacked_sheets(6), winding_strip(40, 2), crumpled_sheet(8, 7), twisted_strip(30, 3)}) {
+  for (const auto& s : {research::stacked_sheets(6), research::winding_strip(40, 2),
+                        research::crumpled_sheet(8, 7), research::twisted_strip(30, 3)}) {
     const Topology topo(s.faces, s.num_vertices);
     const auto v0 = points(s.v_t0), v1 = points(s.v_t1);
     for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
@@ -103,7 +104,7 @@ TEST(Bvh, StructureAndFlagsMatchBruteForce) {
 // its range, for flags of several bits on none, few, many and all of the faces.
 TEST(Bvh, NodesHoldingIsTheOrOfTheFlagsBelow) {
   std::mt19937_64 rng(5);
-  for (const auto& s : {crumpled_sheet(10, 3), twisted_strip(30, 3)}) {
+  for (const auto& s : {research::crumpled_sheet(10, 3), research::twisted_strip(30, 3)}) {
     const Topology topo(s.faces, s.num_vertices);
     const auto v0 = points(s.v_t0);
     for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
@@ -166,7 +167,8 @@ TEST(Bvh, ConnectedFlagMatchesBruteForceOnRandomMeshes) {
 // vertices moved, a static refit between, other options, a switch from one to the other) give
 // after every call, bit for bit, the boxes and cones of a fresh full refit, for every policy.
 TEST(Bvh, RefitChangedEqualsFullRefitAfterEveryCall) {
-  for (const auto& s : {crumpled_sheet(8, 7), twisted_strip(30, 3), stacked_sheets(6)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 7), research::twisted_strip(30, 3),
+                        research::stacked_sheets(6)}) {
     const Topology topo(s.faces, s.num_vertices);
     const auto v0 = points(s.v_t0);
     // The three policies, then the research reference (optimal cones).
@@ -183,31 +185,41 @@ TEST(Bvh, RefitChangedEqualsFullRefitAfterEveryCall) {
       auto last_v1 = v1;
       RefitOptions ro;
       ro.policy = policy;
-      ro.optimal_cones = optimal;
       ro.thickness = 1e-3;
+      // Each refit of the tree, with the optimal cones where asked.
+      using detail::OptimalCones;
+      const bool opt = optimal;
+      auto refit_static = [&](Bvh& b) { opt ? OptimalCones::refit(b, v0, ro) : b.refit(v0, ro); };
+      auto refit = [&](Bvh& b) { opt ? OptimalCones::refit(b, v0, v1, ro) : b.refit(v0, v1, ro); };
+      auto refit_changed = [&](Bvh& b) {
+        opt ? OptimalCones::refit_changed(b, v0, v1, ro) : b.refit_changed(v0, v1, ro);
+      };
+      auto refit_moved = [&](Bvh& b, std::span<const std::uint8_t> moved) {
+        opt ? OptimalCones::refit_moved(b, v0, v1, ro, moved) : b.refit_moved(v0, v1, ro, moved);
+      };
       for (int call = 0; call < 6; ++call) {
         if (call == 3) {  // static: the next call starts over
-          reused.refit(v0, ro);
-          flagged.refit(v0, ro);
+          refit_static(reused);
+          refit_static(flagged);
         }
         if (call == 4) ro.thickness = 2e-3;  // other options: likewise
         if (call > 0) {
           for (std::size_t v = call; v < v1.size(); v += 11)
             v1[v] += Eigen::Vector3d(0.02 * call, -0.01, 0.03);
         }
-        reused.refit_changed(v0, v1, ro);
+        refit_changed(reused);
         // The vertices whose motion changed since the last call (v0 stays).
         std::vector<std::uint8_t> moved(v1.size(), 0);
         for (std::size_t v = 0; v < v1.size(); ++v)
           moved[v] = v1[v] != last_v1[v] ? 1 : 0;
         last_v1 = v1;
         if (call == 5) {
-          flagged.refit_changed(v0, v1, ro);  // after refit_moved: no copies, a full refit
+          refit_changed(flagged);  // after refit_moved: no copies, a full refit
         } else {
-          flagged.refit_moved(v0, v1, ro, moved);
+          refit_moved(flagged, moved);
         }
         Bvh fresh(topo, v0, BvhBuild::Spatial);
-        fresh.refit(v0, v1, ro);
+        refit(fresh);
         for (const Bvh* tree : {&reused, &flagged}) {
           for (std::size_t i = 0; i < fresh.nodes().size(); ++i) {
             for (int k = 0; k < 3; ++k) {
@@ -228,7 +240,8 @@ TEST(Bvh, RefitChangedEqualsFullRefitAfterEveryCall) {
 // the step, and refit_moved() still gives the full refit's boxes and cones bit for bit.
 TEST(Bvh, ConeMinTrianglesConesHoldTheirNormalsAndRefitMovedMatches) {
   int total_narrow = 0;  // cones below pi/2 checked
-  for (const auto& s : {crumpled_sheet(8, 7), twisted_strip(30, 3), stacked_sheets(6)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 7), research::twisted_strip(30, 3),
+                        research::stacked_sheets(6)}) {
     const Topology topo(s.faces, s.num_vertices);
     const auto v0 = points(s.v_t0);
     for (const ConePolicy policy : {ConePolicy::Provot, ConePolicy::Proposed}) {
@@ -309,7 +322,7 @@ TEST(Bvh, ConeMinTrianglesConesHoldTheirNormalsAndRefitMovedMatches) {
 // it (and a copy, and a moved tree) refits to the same boxes, cones and contours as a tree whose
 // Topology is still alive.
 TEST(Bvh, OutlivesItsTopology) {
-  const ProceduralScene s = crumpled_sheet(8, 7);
+  const research::ProceduralScene s = research::crumpled_sheet(8, 7);
   const auto v0 = points(s.v_t0), v1 = points(s.v_t1);
   const Topology kept(s.faces, s.num_vertices);
   Bvh reference(kept, v0, BvhBuild::Patch);
@@ -357,7 +370,8 @@ TEST(Bvh, OutlivesItsTopology) {
 
 // A boxes-only build: the full build's nodes, permutation and boxes, without flags or contours.
 TEST(Bvh, BoxesOnlyIsTheSameTreeWithoutFlags) {
-  for (const auto& s : {stacked_sheets(6), crumpled_sheet(8, 7), twisted_strip(30, 3)}) {
+  for (const auto& s : {research::stacked_sheets(6), research::crumpled_sheet(8, 7),
+                        research::twisted_strip(30, 3)}) {
     const Topology topo(s.faces, s.num_vertices);
     const auto v0 = points(s.v_t0), v1 = points(s.v_t1);
     for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
@@ -392,7 +406,8 @@ TEST(Bvh, BoxesOnlyIsTheSameTreeWithoutFlags) {
 // threads. Meshes large enough for several parallel levels, one of them in separate pieces (the
 // patch build's component split), built on one thread and on eight.
 TEST(Bvh, TheSameTreeOnOneThreadAndOnEight) {
-  for (const auto& s : {crumpled_sheet(100, 5), stacked_sheets(70), twisted_strip(800, 12)}) {
+  for (const auto& s : {research::crumpled_sheet(100, 5), research::stacked_sheets(70),
+                        research::twisted_strip(800, 12)}) {
     const Topology topo(s.faces, s.num_vertices);
     const auto v0 = points(s.v_t0);
     ASSERT_GT(topo.num_faces(), 8 * 2048);  // three levels of parallel splits

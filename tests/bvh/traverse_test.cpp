@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "bvh/traversal.hpp"
 #include "clothcd/research/procedural.hpp"
-#include "detect/traversal.hpp"
 
 // Helpers in a namespace of their own: the tests of a folder may share one translation unit.
 namespace clothcd::traverse_test {
@@ -49,7 +49,8 @@ PairSet brute_force(const Bvh& a, const Bvh& b, bool self) {
 }
 
 TEST(Traverse, SelfPairsAreTheOverlappingLeafBoxes) {
-  for (const auto& s : {crumpled_sheet(14, 3), twisted_strip(40, 3), winding_strip(48, 2)}) {
+  for (const auto& s : {research::crumpled_sheet(14, 3), research::twisted_strip(40, 3),
+                        research::winding_strip(48, 2)}) {
     const Topology topo(s.faces, s.num_vertices);
     const auto v0 = points(s.v_t0), v1 = points(s.v_t1);
     for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
@@ -77,7 +78,8 @@ TEST(Traverse, SelfPairsAreTheOverlappingLeafBoxes) {
 
 TEST(Traverse, PairPairsAreTheOverlappingLeafBoxesOfTwoMeshes) {
   // Two crumpled sheets, the second shifted so that they overlap in part.
-  const ProceduralScene a = crumpled_sheet(7, 1), b = crumpled_sheet(5, 2);
+  const research::ProceduralScene a = research::crumpled_sheet(7, 1),
+                                  b = research::crumpled_sheet(5, 2);
   const Topology ta(a.faces, a.num_vertices), tb(b.faces, b.num_vertices);
   const Eigen::Vector3d shift(0.3, 0.05, 0.2);
   const auto a0 = points(a.v_t0), a1 = points(a.v_t1);
@@ -139,7 +141,8 @@ void expect_same(const Trace& a, const Trace& b) {
 }
 
 TEST(Traverse, RunMakesTheSameTestsAndPairsAsItsSteps) {
-  const ProceduralScene a = crumpled_sheet(12, 4), b = twisted_strip(40, 3);
+  const research::ProceduralScene a = research::crumpled_sheet(12, 4),
+                                  b = research::twisted_strip(40, 3);
   const Topology ta(a.faces, a.num_vertices), tb(b.faces, b.num_vertices);
   const auto a0 = points(a.v_t0), a1 = points(a.v_t1);
   const auto b0 = points(b.v_t0, {0.2, 0.1, 0.0}), b1 = points(b.v_t1, {0.2, 0.1, 0.0});

@@ -26,7 +26,7 @@ namespace clothcd::face_batch_test {
 namespace {
 
 using V = Eigen::Vector3d;
-using detail::FacePairBatch;
+using ccd_detail::FacePairBatch;
 using test::Gen;
 
 // Corners of a at t0, a at t1, b at t0, b at t1.
@@ -81,7 +81,7 @@ Pair make_pair(Gen& g, int family) {
   return p;
 }
 
-detail::Triangle tri(const Pair& p, int first) {
+ccd_detail::Triangle tri(const Pair& p, int first) {
   return {&p[first], &p[first + 1], &p[first + 2]};
 }
 
@@ -92,7 +92,7 @@ std::uint64_t bits(double x) {
 // The Eigen formulation of triangles_filter_culls that the lane-generic code replaced.
 namespace eigen_form {
 
-double plane_separation(const detail::Triangle& a, const detail::Triangle& b) {
+double plane_separation(const ccd_detail::Triangle& a, const ccd_detail::Triangle& b) {
   const V u = *a[1] - *a[0], v = *a[2] - *a[0];
   const V w = u.cross(v);
   const double w2 = w.squaredNorm();
@@ -107,7 +107,7 @@ double plane_separation(const detail::Triangle& a, const detail::Triangle& b) {
   return side / std::sqrt(w2);
 }
 
-double box_gap(const detail::Triangle& a, const detail::Triangle& b) {
+double box_gap(const ccd_detail::Triangle& a, const ccd_detail::Triangle& b) {
   V lo_a = *a[0], hi_a = *a[0], lo_b = *b[0], hi_b = *b[0];
   for (int k = 1; k < 3; ++k) {
     lo_a = lo_a.cwiseMin(*a[k]);
@@ -118,14 +118,14 @@ double box_gap(const detail::Triangle& a, const detail::Triangle& b) {
   return (lo_b - hi_a).cwiseMax(lo_a - hi_b).cwiseMax(0.0).norm();
 }
 
-double slack(const detail::Triangle& a, const detail::Triangle& b) {
+double slack(const ccd_detail::Triangle& a, const ccd_detail::Triangle& b) {
   double m = 1.0;
   for (const V* p : {a[0], a[1], a[2], b[0], b[1], b[2]})
     m = std::max(m, p->cwiseAbs().maxCoeff());
   return 1e-12 * m;
 }
 
-double bound_less(const detail::Triangle& a, const detail::Triangle& b, double s) {
+double bound_less(const ccd_detail::Triangle& a, const ccd_detail::Triangle& b, double s) {
   const double bound = std::max({box_gap(a, b), plane_separation(a, b), plane_separation(b, a)});
   return std::max(0.0, bound - s);
 }
@@ -165,12 +165,13 @@ TEST(FaceBatch, EveryInstructionSetGivesTheScalarVerdictAndBoundBitForBit) {
     const double thickness = round % 3 == 0 ? 0.0 : std::ldexp(1.0, -g.integer(10, 20));
     std::array<bool, FacePairBatch::kCapacity> want{}, got{};
     std::array<double, FacePairBatch::kCapacity> want_d{}, got_d{};
-    ASSERT_TRUE(detail::triangles_filter_batch_with(0, b, thickness, want.data(), want_d.data()));
+    ASSERT_TRUE(
+        ccd_detail::triangles_filter_batch_with(0, b, thickness, want.data(), want_d.data()));
     for (int i = 0; i < n; ++i) {
       double d1 = -1.0;
       const Pair& p = pairs[i];
-      EXPECT_EQ(want[i], detail::triangles_filter_culls(tri(p, 0), tri(p, 3), tri(p, 6), tri(p, 9),
-                                                        thickness, &d1));
+      EXPECT_EQ(want[i], ccd_detail::triangles_filter_culls(tri(p, 0), tri(p, 3), tri(p, 6),
+                                                            tri(p, 9), thickness, &d1));
       EXPECT_EQ(bits(want_d[i]), bits(d1));
       (want[i] ? culled : kept) += 1;
     }
@@ -178,9 +179,9 @@ TEST(FaceBatch, EveryInstructionSetGivesTheScalarVerdictAndBoundBitForBit) {
       got.fill(false);
       got_d.fill(-1.0);
       if (isa == 4) {
-        detail::triangles_filter_batch(b, thickness, got.data(), got_d.data());
-      } else if (!detail::triangles_filter_batch_with(isa, b, thickness, got.data(),
-                                                      got_d.data())) {
+        ccd_detail::triangles_filter_batch(b, thickness, got.data(), got_d.data());
+      } else if (!ccd_detail::triangles_filter_batch_with(isa, b, thickness, got.data(),
+                                                          got_d.data())) {
         continue;  // the processor lacks it
       }
       for (int i = 0; i < n; ++i) {
@@ -205,8 +206,8 @@ TEST(FaceBatch, ScalarFilterIsTheEigenFormulationBitForBitOnFiniteInput) {
     const double thickness = std::ldexp(1.0, -g.integer(10, 20));
     double want_d = 0.0, got_d = 0.0;
     const bool want = eigen_form::filter(p, thickness, want_d);
-    const bool got = detail::triangles_filter_culls(tri(p, 0), tri(p, 3), tri(p, 6), tri(p, 9),
-                                                    thickness, &got_d);
+    const bool got = ccd_detail::triangles_filter_culls(tri(p, 0), tri(p, 3), tri(p, 6), tri(p, 9),
+                                                        thickness, &got_d);
     ASSERT_EQ(got, want) << "pair " << i;
     ASSERT_EQ(bits(got_d), bits(want_d)) << "pair " << i;
     culled += got ? 1 : 0;
@@ -218,25 +219,25 @@ TEST(FaceBatch, StaticBoundOfEveryInstructionSetIsTheScalarBoundBitForBit) {
   Gen g(99);
   int compared = 0, positive = 0;
   for (int round = 0; round < 60; ++round) {
-    detail::StaticFacePairBatch b;
-    const int n = round < detail::StaticFacePairBatch::kCapacity
+    ccd_detail::StaticFacePairBatch b;
+    const int n = round < ccd_detail::StaticFacePairBatch::kCapacity
                       ? round + 1
-                      : detail::StaticFacePairBatch::kCapacity;
+                      : ccd_detail::StaticFacePairBatch::kCapacity;
     std::vector<Pair> pairs;
     for (int i = 0; i < n; ++i) {
       pairs.push_back(make_pair(g, (round + i) % kFamilies));
       b.push(tri(pairs.back(), 3), tri(pairs.back(), 9));
     }
-    std::array<double, detail::StaticFacePairBatch::kCapacity> want{}, got{};
+    std::array<double, ccd_detail::StaticFacePairBatch::kCapacity> want{}, got{};
     for (int i = 0; i < n; ++i) {
-      want[i] = detail::triangle_triangle_bound(tri(pairs[i], 3), tri(pairs[i], 9));
+      want[i] = ccd_detail::triangle_triangle_bound(tri(pairs[i], 3), tri(pairs[i], 9));
       positive += want[i] > 0 ? 1 : 0;
     }
     for (int isa = 0; isa <= 4; ++isa) {
       got.fill(-1.0);
       if (isa == 4) {
-        detail::triangle_bound_batch(b, got.data());
-      } else if (!detail::triangle_bound_batch_with(isa, b, got.data())) {
+        ccd_detail::triangle_bound_batch(b, got.data());
+      } else if (!ccd_detail::triangle_bound_batch_with(isa, b, got.data())) {
         continue;
       }
       for (int i = 0; i < n; ++i) {
@@ -259,7 +260,7 @@ TEST(FaceBatch, BoundAtT1IsALowerBoundOfEveryFeatureDistance) {
     b.push(tri(p, 0), tri(p, 3), tri(p, 6), tri(p, 9));
     bool culls = false;
     double d1 = 0.0;
-    detail::triangles_filter_batch(b, 0.0, &culls, &d1);
+    ccd_detail::triangles_filter_batch(b, 0.0, &culls, &d1);
     const auto a = tri(p, 3), c = tri(p, 9);
     double nearest = INFINITY;
     for (int k = 0; k < 3; ++k) {

@@ -122,7 +122,7 @@ inline void check_pair_detector(double thickness) {
   const Topology ta(a.faces, a.nv()), tb(b.faces, b.nv());
   DetectOptions o;
   o.thickness = thickness;
-  const PairDetectResult ref = brute_force_detect_pair(ta, a.v0, a.v1, tb, b.v0, b.v1, o);
+  const PairDetectResult ref = research::brute_force_detect_pair(ta, a.v0, a.v1, tb, b.v0, b.v1, o);
   EXPECT_GT(ref.vf_a_on_b.size(), 0u);
   EXPECT_GT(ref.vf_b_on_a.size(), 0u);
   EXPECT_GT(ref.ee.size(), 0u);

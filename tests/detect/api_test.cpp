@@ -37,7 +37,8 @@ TEST(DetectApi, PairDetectorEqualsBruteForce) {
   check_pair_detector(0.0);
 }
 TEST(DetectApi, ProximityEqualsAllPairsDistance) {
-  for (const auto& s : {crumpled_sheet(8, 2), twisted_strip(30, 3), stacked_sheets(6)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 2), research::twisted_strip(30, 3),
+                        research::stacked_sheets(6)}) {
     const Topology topo(s.faces, s.num_vertices);
     // A folded state (the end of the motion), where features come close.
     const Positions v = 0.5 * (s.v_t0 + s.v_t1);
@@ -65,8 +66,8 @@ TEST(DetectApi, ProximityEqualsAllPairsDistance) {
 // A detector restricted by `restrict` finds `ref`, a strict non-empty part of `full`, and
 // `full` again once the restriction is cleared; both builds, with and without culling.
 template <class Restrict>
-void check_restricted(const ProceduralScene& s, const DetectResult& full, const DetectResult& ref,
-                      Restrict&& restrict) {
+void check_restricted(const research::ProceduralScene& s, const DetectResult& full,
+                      const DetectResult& ref, Restrict&& restrict) {
   EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u) << s.name;
   EXPECT_LT(ref.vf.size() + ref.ee.size(), full.vf.size() + full.ee.size()) << s.name;
   for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
@@ -90,7 +91,7 @@ void check_restricted(const ProceduralScene& s, const DetectResult& full, const 
 }
 
 TEST(DetectApi, ActiveFacesEqualFilteredBruteForce) {
-  for (const auto& s : {crumpled_sheet(8, 3), twisted_strip(30, 3)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 3), research::twisted_strip(30, 3)}) {
     const Topology topo(s.faces, s.num_vertices);
     // Every third face, and a contiguous block: both sparse and clustered sets.
     std::vector<int> active;
@@ -101,14 +102,14 @@ TEST(DetectApi, ActiveFacesEqualFilteredBruteForce) {
         mask[f] = 1;
       }
     }
-    const DetectResult full = brute_force_detect(topo, s.v_t0, s.v_t1);
-    const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1, {}, mask);
+    const DetectResult full = research::brute_force_detect(topo, s.v_t0, s.v_t1);
+    const DetectResult ref = research::brute_force_detect(topo, s.v_t0, s.v_t1, {}, mask);
     check_restricted(s, full, ref, [&](SelfDetector& d) { d.set_active_faces(active); });
   }
 }
 
 TEST(DetectApi, ActiveVerticesEqualFilteredBruteForce) {
-  for (const auto& s : {crumpled_sheet(8, 3), twisted_strip(30, 3)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 3), research::twisted_strip(30, 3)}) {
     const Topology topo(s.faces, s.num_vertices);
     // Every fifth vertex, and a contiguous block: both sparse and clustered sets.
     std::vector<int> active;
@@ -120,7 +121,7 @@ TEST(DetectApi, ActiveVerticesEqualFilteredBruteForce) {
       }
     }
     // The oracle: every pair of the full brute force with an active vertex.
-    const DetectResult full = brute_force_detect(topo, s.v_t0, s.v_t1);
+    const DetectResult full = research::brute_force_detect(topo, s.v_t0, s.v_t1);
     DetectResult ref;
     for (const auto& c : full.vf) {
       const Face& f = c.face_vertices;
@@ -143,7 +144,7 @@ TEST(DetectApi, ActiveVerticesEqualFilteredBruteForce) {
 // that call's positions. The moved and the active vertices differ on purpose: the reuse must not
 // depend on the caller's restriction.
 TEST(DetectApi, ReusedDetectorEqualsBruteForceOverASequenceOfCalls) {
-  for (const auto& s : {crumpled_sheet(8, 3), twisted_strip(30, 3)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 3), research::twisted_strip(30, 3)}) {
     const Topology topo(s.faces, s.num_vertices);
     for (Culling culling : {Culling::None, Culling::Sound}) {
       SCOPED_TRACE(::testing::Message() << s.name << " culling " << int(culling));
@@ -180,7 +181,7 @@ TEST(DetectApi, ReusedDetectorEqualsBruteForceOverASequenceOfCalls) {
           det.clear_active();
         }
         const DetectResult r = det.detect(x0, x1);
-        const DetectResult all = brute_force_detect(topo, x0, x1);
+        const DetectResult all = research::brute_force_detect(topo, x0, x1);
         DetectResult ref;
         for (const auto& c : all.vf) {
           const Face& f = c.face_vertices;
@@ -206,11 +207,12 @@ TEST(DetectApi, ReusedDetectorEqualsBruteForceOverASequenceOfCalls) {
 // cleared, and a reference of the wrong size an InputError.
 TEST(DetectApi, RebuiltDetectorEqualsBruteForce) {
   int changed = 0;  // cases in which the rebuilt tree differs from the original one
-  for (const auto& s : {crumpled_sheet(8, 3), twisted_strip(30, 3), stacked_sheets(6)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 3), research::twisted_strip(30, 3),
+                        research::stacked_sheets(6)}) {
     const Topology topo(s.faces, s.num_vertices);
     const Positions mid = 0.5 * (s.v_t0 + s.v_t1);
-    const DetectResult ref0 = brute_force_detect(topo, s.v_t0, mid);
-    const DetectResult ref1 = brute_force_detect(topo, mid, s.v_t1);
+    const DetectResult ref0 = research::brute_force_detect(topo, s.v_t0, mid);
+    const DetectResult ref1 = research::brute_force_detect(topo, mid, s.v_t1);
     const ProximityResult near = brute_force_proximity(topo, s.v_t1, 0.01);
     EXPECT_GT(ref1.vf.size() + ref1.ee.size(), 0u);
     for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
@@ -265,7 +267,7 @@ TEST(DetectApi, RebuiltDetectorEqualsBruteForce) {
 using test::counters;
 
 TEST(DetectApi, DeterministicOnOneTwoAndFourThreads) {
-  const ProceduralScene s = crumpled_sheet(16, 5);
+  const research::ProceduralScene s = research::crumpled_sheet(16, 5);
   const Mesh a = sheet(10);
   const Mesh b = ball(3, 0.18, {0.47, 0.52, 0.2}, {0.5, 0.49, 0.05});
   for (research::CullingRule culling :
@@ -307,9 +309,9 @@ TEST(DetectApi, DeterministicOnOneTwoAndFourThreads) {
 // without culling, equals brute force with the same links, which equals brute force without links
 // minus exactly the pairs that join two linked vertices.
 TEST(DetectApi, LinkedVerticesDropExactlyThePairsJoiningThem) {
-  const ProceduralScene s = crumpled_sheet(12, 6);
+  const research::ProceduralScene s = research::crumpled_sheet(12, 6);
   const Topology topo(s.faces, s.num_vertices);
-  const DetectResult all = brute_force_detect(topo, s.v_t0, s.v_t1);
+  const DetectResult all = research::brute_force_detect(topo, s.v_t0, s.v_t1);
   ASSERT_GE(all.vf.size(), 3u);
   ASSERT_GE(all.ee.size(), 3u);
   // Link the two ends of every third colliding VF pair (vertex with a face corner) and of every
@@ -341,7 +343,7 @@ TEST(DetectApi, LinkedVerticesDropExactlyThePairsJoiningThem) {
   }
   ASSERT_LT(expected.vf.size(), all.vf.size());
   ASSERT_LT(expected.ee.size(), all.ee.size());
-  const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1, o);
+  const DetectResult ref = research::brute_force_detect(topo, s.v_t0, s.v_t1, o);
   EXPECT_EQ(ref.vf, expected.vf);
   EXPECT_EQ(ref.ee, expected.ee);
   for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
@@ -368,7 +370,7 @@ TEST(DetectApi, LinkedVerticesDropExactlyThePairsJoiningThem) {
 }
 
 TEST(DetectApi, LinkedVertexOutOfRangeIsAnInputError) {
-  const ProceduralScene s = crumpled_sheet(3, 1);
+  const research::ProceduralScene s = research::crumpled_sheet(3, 1);
   DetectOptions o;
   o.linked_vertices = {{0, s.num_vertices}};
   SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);

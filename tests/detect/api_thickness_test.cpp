@@ -24,15 +24,17 @@ TEST(DetectApi, PairDetectorWithThicknessEqualsBruteForce) {
 
 TEST(DetectApi, ThicknessEqualsBruteForce) {
   // Thick CCD kernels are slow on the near-coplanar stacked sheets, so those are left out here.
-  const std::pair<ProceduralScene, double> cases[] = {
-      {crumpled_sheet(7, 4), 0.001}, {crumpled_sheet(7, 4), 0.01}, {winding_strip(36, 2), 0.001}};
+  const std::pair<research::ProceduralScene, double> cases[] = {
+      {research::crumpled_sheet(7, 4), 0.001},
+      {research::crumpled_sheet(7, 4), 0.01},
+      {research::winding_strip(36, 2), 0.001}};
   std::uint64_t apart = 0, culled = 0;
   for (const auto& [s, thickness] : cases) {
     const Topology topo(s.faces, s.num_vertices);
     DetectOptions o;
     o.thickness = thickness;
-    const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1, o);
-    const DetectResult thin = brute_force_detect(topo, s.v_t0, s.v_t1);
+    const DetectResult ref = research::brute_force_detect(topo, s.v_t0, s.v_t1, o);
+    const DetectResult thin = research::brute_force_detect(topo, s.v_t0, s.v_t1);
     // A thickness finds at least what zero thickness finds.
     EXPECT_GT(thin.vf.size() + thin.ee.size(), 0u) << s.name;
     EXPECT_GE(ref.vf.size() + ref.ee.size(), thin.vf.size() + thin.ee.size()) << s.name;
@@ -70,20 +72,22 @@ double sampled_min(Distance&& at) {
 TEST(DetectApi, DeeperDistanceFilterDropsOnlyPairsThatStayApart) {
   // The thick kernels are conservative (a hit certifies a distance within sqrt(3) thickness):
   // the deeper filter drops some of those hits, and only ones whose pair stays apart.
-  const std::pair<ProceduralScene, double> cases[] = {
-      {crumpled_sheet(7, 4), 0.001}, {crumpled_sheet(7, 4), 0.01}, {winding_strip(36, 2), 0.001}};
+  const std::pair<research::ProceduralScene, double> cases[] = {
+      {research::crumpled_sheet(7, 4), 0.001},
+      {research::crumpled_sheet(7, 4), 0.01},
+      {research::winding_strip(36, 2), 0.001}};
   std::size_t dropped = 0;
   for (const auto& entry : cases) {
     // Named, not structured bindings: the lambdas below capture them (clang 14 cannot).
-    const ProceduralScene& s = entry.first;
+    const research::ProceduralScene& s = entry.first;
     const double thickness = entry.second;
     SCOPED_TRACE(::testing::Message() << s.name << " thickness " << thickness);
     const Topology topo(s.faces, s.num_vertices);
     DetectOptions o;
     o.thickness = thickness;
-    const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1, o);
+    const DetectResult ref = research::brute_force_detect(topo, s.v_t0, s.v_t1, o);
     o.distance_filter_depth = 6;
-    const DetectResult deep = brute_force_detect(topo, s.v_t0, s.v_t1, o);
+    const DetectResult deep = research::brute_force_detect(topo, s.v_t0, s.v_t1, o);
     EXPECT_GT(deep.vf.size() + deep.ee.size(), 0u);
     auto at = [&](int i, double t) {
       return Eigen::Vector3d(s.v_t0.row(i) + t * (s.v_t1.row(i) - s.v_t0.row(i)));

@@ -53,8 +53,8 @@ DetectResult run_kernels(const Topology& topo, const Positions& x0, const Positi
 }
 
 TEST(Candidates, KernelsOnTheCandidatesFindWhatTheDetectorFinds) {
-  for (const auto& s :
-       {crumpled_sheet(24, 5), twisted_strip(80, 4), winding_strip(96, 3), stacked_sheets(10)}) {
+  for (const auto& s : {research::crumpled_sheet(24, 5), research::twisted_strip(80, 4),
+                        research::winding_strip(96, 3), research::stacked_sheets(10)}) {
     const Topology topo(s.faces, s.num_vertices);
     for (bool linked : {false, true}) {
       SCOPED_TRACE(::testing::Message() << s.name << " linked " << linked);
@@ -144,7 +144,7 @@ TEST(Candidates, KernelsOnTheCandidatesFindWhatTheDetectorFinds) {
 }
 
 TEST(Candidates, PairsSharingAVertexYieldNothingAndOrderDoesNotMatter) {
-  const ProceduralScene s = crumpled_sheet(6, 2);
+  const research::ProceduralScene s = research::crumpled_sheet(6, 2);
   const Topology topo(s.faces, s.num_vertices);
   const Candidates c(topo);
   for (int f = 0; f < topo.num_faces(); ++f) {

@@ -16,8 +16,8 @@ namespace clothcd::cull_threshold_test {
 namespace {
 
 // A gently waving grid sheet (nu x nv quads over [0, 1]^2) at `phase`: most of it can be culled.
-ProceduralScene waving_sheet(int n, double phase, double motion) {
-  ProceduralScene s;
+research::ProceduralScene waving_sheet(int n, double phase, double motion) {
+  research::ProceduralScene s;
   s.name = "waving sheet";
   s.num_vertices = (n + 1) * (n + 1);
   s.v_t0.resize(s.num_vertices, 3);
@@ -61,10 +61,11 @@ void expect_same(const ProximityResult& r, const ProximityResult& ref) {
 }
 
 TEST(CullMinTriangles, SameResultsAsNoCullingOverConsecutiveSteps) {
-  const ProceduralScene scenes[] = {waving_sheet(24, 0.0, 0.3), crumpled_sheet(8, 7),
-                                    twisted_strip(30, 3), stacked_sheets(6), winding_strip(40, 2)};
+  const research::ProceduralScene scenes[] = {
+      waving_sheet(24, 0.0, 0.3), research::crumpled_sheet(8, 7), research::twisted_strip(30, 3),
+      research::stacked_sheets(6), research::winding_strip(40, 2)};
   std::uint64_t culled[2] = {0, 0};  // threshold 0, and the others
-  for (const ProceduralScene& s : scenes) {
+  for (const research::ProceduralScene& s : scenes) {
     for (const double thickness : {0.0, 1e-5, 1e-3}) {
       for (const double reuse : {0.0, 1e-3}) {
         DetectOptions o;
@@ -108,7 +109,7 @@ TEST(CullMinTriangles, SameResultsAsNoCullingOverConsecutiveSteps) {
 // Culled nodes all hold at least the threshold's triangles: a threshold above the root's size
 // culls nothing, and the counters of the paper's rule are those of threshold 0.
 TEST(CullMinTriangles, ThresholdBoundsTheTestedNodes) {
-  const ProceduralScene s = waving_sheet(24, 0.0, 0.3);
+  const research::ProceduralScene s = waving_sheet(24, 0.0, 0.3);
   DetectOptions o;
   o.build = BvhBuild::Patch;
   o.culling = Culling::Sound;

@@ -53,15 +53,15 @@ std::vector<DetectOptions> all_configs(double thickness) {
 // Each scene with the thicknesses it is run at: a thickness makes the kernels' work grow fast
 // on these tight folds, so the larger scenes run at zero thickness only.
 struct Case {
-  ProceduralScene scene;
+  research::ProceduralScene scene;
   std::vector<double> thicknesses;
 };
 std::vector<Case> cases() {
-  return {{stacked_sheets(8), {0.0}},
-          {winding_strip(96, 3), {0.0}},
-          {crumpled_sheet(14, 3), {0.0}},
-          {crumpled_sheet(8, 5), {2e-3}},
-          {twisted_strip(60, 4), {0.0}}};
+  return {{research::stacked_sheets(8), {0.0}},
+          {research::winding_strip(96, 3), {0.0}},
+          {research::crumpled_sheet(14, 3), {0.0}},
+          {research::crumpled_sheet(8, 5), {2e-3}},
+          {research::twisted_strip(60, 4), {0.0}}};
 }
 
 TEST(DetectEach, EqualsOneDetectPerConfiguration) {
@@ -107,7 +107,7 @@ TEST(DetectEach, EqualsOneDetectPerConfiguration) {
 // The same detector, called for both forms, after a detect() and before one: state from one
 // call (moved-vertex refits, cones of another policy) must not leak into the next.
 TEST(DetectEach, InterleavesWithDetect) {
-  const ProceduralScene s = crumpled_sheet(16, 11);
+  const research::ProceduralScene s = research::crumpled_sheet(16, 11);
   DetectOptions sound;
   sound.culling = Culling::Sound;
   SelfDetector det(s.faces, s.num_vertices, s.v_t0, sound);
@@ -132,7 +132,7 @@ TEST(DetectEach, InterleavesWithDetect) {
 }
 
 TEST(DetectEach, RefusesConfigurationsThatShareNoNarrowPhase) {
-  const ProceduralScene s = stacked_sheets(6);
+  const research::ProceduralScene s = research::stacked_sheets(6);
   SelfDetector det(s.faces, s.num_vertices, s.v_t0);
   const DetectOptions before = det.options();
   auto refused = [&](std::vector<DetectOptions> configs) {

@@ -99,7 +99,8 @@ std::vector<Eigen::Vector3d> rows(const Positions& p) {
 
 TEST(FaceBoxes, SameFeaturePairsAsTheSeparateBoxesOnProceduralMeshes) {
   test::Gen gen(3);
-  for (const auto& s : {crumpled_sheet(8, 3), twisted_strip(24, 3), stacked_sheets(4)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 3), research::twisted_strip(24, 3),
+                        research::stacked_sheets(4)}) {
     SCOPED_TRACE(s.name);
     EXPECT_GT(check_mesh(s.faces, rows(s.v_t0), rows(s.v_t1), gen), 100u);
   }

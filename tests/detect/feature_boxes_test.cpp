@@ -34,7 +34,7 @@ void expect_own_boxes(const detail::FeatureContext& ctx) {
 }
 
 TEST(FeatureBoxes, EqualEachFeaturesOwnSweptBox) {
-  const ProceduralScene s = crumpled_sheet(9, 3);
+  const research::ProceduralScene s = research::crumpled_sheet(9, 3);
   const Topology topo(s.faces, s.num_vertices);
   std::vector<Eigen::Vector3d> v0(s.num_vertices), v1(s.num_vertices);
   std::mt19937_64 rng(5);

@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "api_scenes.hpp"
+#include "bvh/front.hpp"
 #include "clothcd/bvh/bvh.hpp"
 #include "clothcd/bvh/traverse.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/mesh/topology.hpp"
 #include "clothcd/research/procedural.hpp"
-#include "detect/front.hpp"
 
 namespace clothcd {
 namespace {
@@ -27,11 +27,11 @@ using Pairs = std::vector<std::pair<int, int>>;
 // Steps (t0, t1) of a scene: its step in six substeps (each frame slightly perturbed, as a
 // simulator's are), then a still step with everything spread out 30-fold about the first vertex
 // (most boxes apart), then the last substep again.
-std::vector<std::pair<Positions, Positions>> front_steps(const ProceduralScene& s) {
+std::vector<std::pair<Positions, Positions>> front_steps(const research::ProceduralScene& s) {
   std::vector<Positions> f;
   for (int i = 0; i <= 6; ++i) {
     const double t = i / 6.0;
-    f.push_back(smooth_perturbation((1 - t) * s.v_t0 + t * s.v_t1, 0.003, 0.5, 7 + i));
+    f.push_back(research::smooth_perturbation((1 - t) * s.v_t0 + t * s.v_t1, 0.003, 0.5, 7 + i));
   }
   std::vector<std::pair<Positions, Positions>> out;
   for (int i = 0; i < 6; ++i)
@@ -44,8 +44,9 @@ std::vector<std::pair<Positions, Positions>> front_steps(const ProceduralScene& 
   return out;
 }
 
-std::vector<ProceduralScene> front_scenes() {
-  return {crumpled_sheet(10, 3), twisted_strip(40, 3), stacked_sheets(5), winding_strip(48, 2)};
+std::vector<research::ProceduralScene> front_scenes() {
+  return {research::crumpled_sheet(10, 3), research::twisted_strip(40, 3),
+          research::stacked_sheets(5), research::winding_strip(48, 2)};
 }
 
 std::vector<Eigen::Vector3d> points(const Positions& p) {

@@ -41,7 +41,8 @@ Garment load(const std::filesystem::path& obj, int vertices, int faces, double a
   EXPECT_EQ(sewn.report.components_after, 1);
   Garment g;
   g.sewn = sewn.mesh;
-  const Positions moved = smooth_perturbation(vertices_matrix(garment), amplitude, 0.1, 1);
+  const Positions moved =
+      research::smooth_perturbation(vertices_matrix(garment), amplitude, 0.1, 1);
   // Each sewn vertex takes the position of its smallest original id (as weld does).
   g.p0 = vertices_matrix(g.sewn);
   g.p1 = g.p0;
@@ -87,7 +88,7 @@ TEST(Garments, DressPatchConnectedAndSoundCullsHalfOfCone) {
       EXPECT_TRUE(sound.verification.missed_ee.empty());
       EXPECT_EQ(sound.vf, none.vf);
       EXPECT_EQ(sound.ee, none.ee);
-      o.research.unsound_culling = research::UnsoundCulling::Cone;
+      o.research.culling = research::CullingRule::Cone;
       o.research.verify = false;
       det.set_options(o);
       const DetectResult cone = det.detect(g.p0, g.p1);

@@ -58,12 +58,12 @@ TEST(InputForms, RowMajorViewReadsTheMatrixInPlace) {
 }
 
 TEST(InputForms, SelfDetectorGivesTheSameResultsForEveryForm) {
-  const ProceduralScene s = crumpled_sheet(10, 3);
+  const research::ProceduralScene s = research::crumpled_sheet(10, 3);
   DetectOptions o;
   o.culling = Culling::Sound;
   o.thickness = 1e-3;
   const Topology topo(s.faces, s.num_vertices);
-  const DetectResult oracle = brute_force_detect(topo, s.v_t0, s.v_t1, o);
+  const DetectResult oracle = research::brute_force_detect(topo, s.v_t0, s.v_t1, o);
   ASSERT_GT(oracle.vf.size() + oracle.ee.size(), 0u);
 
   const std::vector<Eigen::Vector3d> p0 = points_of(s.v_t0), p1 = points_of(s.v_t1);
@@ -116,7 +116,7 @@ TEST(InputForms, PairDetectorGivesTheSameResultsForEveryForm) {
   const PairDetectResult ref = by_matrix.detect(a.v0, a.v1, b.v0, b.v1);
   ASSERT_GT(ref.vf_a_on_b.size() + ref.vf_b_on_a.size() + ref.ee.size(), 0u);
   const Topology ta(a.faces, a.nv()), tb(b.faces, b.nv());
-  expect_pair_equal(ref, brute_force_detect_pair(ta, a.v0, a.v1, tb, b.v0, b.v1, o));
+  expect_pair_equal(ref, research::brute_force_detect_pair(ta, a.v0, a.v1, tb, b.v0, b.v1, o));
   for (PairDetector* det : {&by_matrix, &by_span, &by_face_matrix}) {
     expect_pair_equal(det->detect(a0, a1, b0, b1), ref);
     expect_pair_equal(det->detect(a.v0, a.v1, b.v0, b.v1), ref);
@@ -137,7 +137,7 @@ TEST(InputForms, PairDetectorGivesTheSameResultsForEveryForm) {
 }
 
 TEST(InputForms, BadSpansAreInputErrors) {
-  const ProceduralScene s = crumpled_sheet(4, 1);
+  const research::ProceduralScene s = research::crumpled_sheet(4, 1);
   std::vector<Eigen::Vector3d> p = points_of(s.v_t0);
   SelfDetector det(s.faces, s.num_vertices, s.v_t0);
   const std::vector<Eigen::Vector3d> short_list(p.begin(), p.end() - 1);

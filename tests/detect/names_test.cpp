@@ -82,8 +82,8 @@ TEST(ResearchNames, EveryRuleRoundTripsThroughNamesAndOptions) {
     o.culling = Culling::Sound;
     research::set_culling_rule(o, c);
     EXPECT_EQ(research::culling_rule(o), c);
-    EXPECT_EQ(o.research.unsound_culling != research::UnsoundCulling::None,
-              c == CullingRule::Cone || c == CullingRule::Gated);
+    EXPECT_EQ(o.research.culling.has_value(), c == CullingRule::Cone || c == CullingRule::Gated);
+    EXPECT_EQ(research::unsound(c), c == CullingRule::Cone || c == CullingRule::Gated);
   }
   for (ConeRule p : {ConeRule::Provot, ConeRule::Proposed, ConeRule::Exact, ConeRule::Optimal}) {
     SCOPED_TRACE(research::to_string(p));
@@ -93,13 +93,7 @@ TEST(ResearchNames, EveryRuleRoundTripsThroughNamesAndOptions) {
     research::set_cone_rule(o, p);
     EXPECT_EQ(research::cone_rule(o), p);
     EXPECT_EQ(o.research.optimal_cones, p == ConeRule::Optimal);
-    RefitOptions ro;
-    research::set_cone_rule(ro, p);
-    EXPECT_EQ(ro.optimal_cones, p == ConeRule::Optimal);
-    if (p != ConeRule::Optimal) {
-      EXPECT_EQ(ro.policy, o.policy);
-      EXPECT_EQ(research::to_string(p), to_string(o.policy));
-    }
+    if (p != ConeRule::Optimal) EXPECT_EQ(research::to_string(p), to_string(o.policy));
   }
   EXPECT_EQ(research::to_string(CullingRule::None), to_string(Culling::None));
   EXPECT_EQ(research::to_string(CullingRule::Sound), to_string(Culling::Sound));
@@ -109,7 +103,7 @@ TEST(ResearchNames, EveryRuleRoundTripsThroughNamesAndOptions) {
   // An unsound rule overrides the culling.
   DetectOptions o;
   o.culling = Culling::Sound;
-  o.research.unsound_culling = research::UnsoundCulling::Gated;
+  o.research.culling = CullingRule::Gated;
   EXPECT_EQ(research::culling_rule(o), CullingRule::Gated);
   try {
     (void)research::parse_culling_rule("fast", "--culling");

@@ -33,10 +33,11 @@ std::vector<std::pair<int, int>> ee_set(const std::vector<EdgeEdgeCollision>& c)
   return s;
 }
 
-std::vector<ProceduralScene> scenes() {
-  std::vector<ProceduralScene> s{stacked_sheets(10), winding_strip(72, 3), twisted_strip(60, 4)};
+std::vector<research::ProceduralScene> scenes() {
+  std::vector<research::ProceduralScene> s{
+      research::stacked_sheets(10), research::winding_strip(72, 3), research::twisted_strip(60, 4)};
   for (std::uint64_t seed = 1; seed <= 3; ++seed)
-    s.push_back(crumpled_sheet(14, seed));
+    s.push_back(research::crumpled_sheet(14, seed));
   return s;
 }
 
@@ -45,7 +46,7 @@ constexpr research::ConeRule kPolicies[] = {research::ConeRule::Provot,
                                             research::ConeRule::Optimal};
 constexpr BvhBuild kBuilds[] = {BvhBuild::Spatial, BvhBuild::Patch};
 
-research::DetectResult run(const ProceduralScene& s, DetectOptions o) {
+research::DetectResult run(const research::ProceduralScene& s, DetectOptions o) {
   SelfDetector d(s.faces, s.num_vertices, s.v_t0, o);
   return d.detect(s.v_t0, s.v_t1);
 }
@@ -53,7 +54,7 @@ research::DetectResult run(const ProceduralScene& s, DetectOptions o) {
 TEST(DetectOracle, NoneAndSoundEqualBruteForce) {
   for (const auto& s : scenes()) {
     const Topology topo(s.faces, s.num_vertices);
-    const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1);
+    const DetectResult ref = research::brute_force_detect(topo, s.v_t0, s.v_t1);
     EXPECT_GT(ref.vf.size() + ref.ee.size(), 0u) << s.name << ": the motion must collide";
     for (BvhBuild build : kBuilds) {
       for (research::ConeRule policy : kPolicies) {
@@ -83,8 +84,8 @@ struct Misses {
   std::size_t found_by_none = 0;
 };
 
-Misses misses(const ProceduralScene& s, research::CullingRule culling, research::ConeRule policy,
-              BvhBuild build) {
+Misses misses(const research::ProceduralScene& s, research::CullingRule culling,
+              research::ConeRule policy, BvhBuild build) {
   DetectOptions o;
   research::set_culling_rule(o, culling);
   research::set_cone_rule(o, policy);
@@ -104,18 +105,18 @@ Misses misses(const ProceduralScene& s, research::CullingRule culling, research:
 // The research options directly, as a measurement sets them: an unsound rule overrides the
 // culling, and verify lists what it missed.
 TEST(DetectOracle, ResearchOptionsOverrideTheCullingAndVerifyListsTheMisses) {
-  const auto s = winding_strip(72, 3);
+  const auto s = research::winding_strip(72, 3);
   DetectOptions o;
   o.build = BvhBuild::Patch;
   o.culling = Culling::Sound;
-  o.research.unsound_culling = research::UnsoundCulling::Gated;
+  o.research.culling = research::CullingRule::Gated;
   o.research.verify = true;
   EXPECT_EQ(research::culling_rule(o), research::CullingRule::Gated);
   const research::DetectResult gated = run(s, o);
   ASSERT_TRUE(gated.verification.ran);
   EXPECT_GT(gated.verification.missed_vf.size() + gated.verification.missed_ee.size(), 0u);
   EXPECT_GT(gated.verification.unculled_triangle_pairs, gated.stats.triangle_pairs);
-  o.research.unsound_culling = research::UnsoundCulling::None;
+  o.research.culling.reset();
   const research::DetectResult sound = run(s, o);
   ASSERT_TRUE(sound.verification.ran);
   EXPECT_TRUE(sound.verification.missed_vf.empty());
@@ -125,7 +126,7 @@ TEST(DetectOracle, ResearchOptionsOverrideTheCullingAndVerifyListsTheMisses) {
 }
 
 TEST(DetectOracle, ConeMissesStackedSheetsGatedDoesNot) {
-  const auto s = stacked_sheets(10);
+  const auto s = research::stacked_sheets(10);
   for (BvhBuild build : kBuilds) {
     for (research::ConeRule policy : kPolicies) {
       const Misses cone = misses(s, research::CullingRule::Cone, policy, build);
@@ -138,7 +139,7 @@ TEST(DetectOracle, ConeMissesStackedSheetsGatedDoesNot) {
 }
 
 TEST(DetectOracle, GatedMissesWindingStripSoundDoesNot) {
-  const auto s = winding_strip(72, 3);
+  const auto s = research::winding_strip(72, 3);
   for (BvhBuild build : kBuilds) {
     for (research::ConeRule policy : kPolicies) {
       SCOPED_TRACE(::testing::Message() << "policy " << int(policy) << " build " << int(build));

@@ -45,8 +45,8 @@ std::size_t check(const Topology& t) {
 }
 
 TEST(Orphans, ProceduralMeshesMatchTheDefinition) {
-  for (const auto& s :
-       {crumpled_sheet(8, 3), twisted_strip(24, 3), winding_strip(24, 2), stacked_sheets(4)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 3), research::twisted_strip(24, 3),
+                        research::winding_strip(24, 2), research::stacked_sheets(4)}) {
     SCOPED_TRACE(s.name);
     check(Topology(s.faces, s.num_vertices));
   }

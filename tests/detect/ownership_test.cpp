@@ -17,8 +17,8 @@ namespace {
 using ownership_check::check_all_pairs;
 
 TEST(Ownership, RecordsAgreeWithTheDefinitionOnProceduralMeshes) {
-  for (const auto& s :
-       {crumpled_sheet(8, 3), twisted_strip(24, 3), winding_strip(24, 2), stacked_sheets(4)}) {
+  for (const auto& s : {research::crumpled_sheet(8, 3), research::twisted_strip(24, 3),
+                        research::winding_strip(24, 2), research::stacked_sheets(4)}) {
     SCOPED_TRACE(s.name);
     const Topology t(s.faces, s.num_vertices);
     EXPECT_GT(check_all_pairs(t), 0u);

@@ -53,7 +53,7 @@ TEST(PairDetector, ThickStepsEqualBruteForceWithFilterDepthAndToiTolerance) {
   for (int depth : {0, 4}) {
     const DetectOptions o = simulator_options(0.004, depth);
     const PairDetectResult ref =
-        brute_force_detect_pair(s.ta, s.a.v0, s.a.v1, s.tb, s.b.v0, s.b.v1, o);
+        research::brute_force_detect_pair(s.ta, s.a.v0, s.a.v1, s.tb, s.b.v0, s.b.v1, o);
     EXPECT_GT(ref.vf_a_on_b.size(), 0u);
     EXPECT_GT(ref.vf_b_on_a.size(), 0u);
     EXPECT_GT(ref.ee.size(), 0u);
@@ -84,7 +84,7 @@ TEST(PairDetector, EveryFilterSettingEqualsBruteForce) {
                    << "thickness " << thickness << " np " << o.np_filter << " fast " << o.fast_path
                    << " distance " << o.distance_filter);
       const PairDetectResult ref =
-          brute_force_detect_pair(s.ta, s.a.v0, s.a.v1, s.tb, s.b.v0, s.b.v1, o);
+          research::brute_force_detect_pair(s.ta, s.a.v0, s.a.v1, s.tb, s.b.v0, s.b.v1, o);
       EXPECT_GT(ref.vf_a_on_b.size() + ref.vf_b_on_a.size() + ref.ee.size(), 0u);
       PairDetector det(s.a.faces, s.a.nv(), s.a.v0, s.b.faces, s.b.nv(), s.b.v0, o);
       expect_pair_equal(det.detect(s.a.v0, s.a.v1, s.b.v0, s.b.v1), ref);
@@ -96,7 +96,7 @@ TEST(PairDetector, ActiveVerticesKeepExactlyThePairsWithAnActiveVertex) {
   const Scene s;
   const DetectOptions o = simulator_options(0.004, 6);
   const PairDetectResult all =
-      brute_force_detect_pair(s.ta, s.a.v0, s.a.v1, s.tb, s.b.v0, s.b.v1, o);
+      research::brute_force_detect_pair(s.ta, s.a.v0, s.a.v1, s.tb, s.b.v0, s.b.v1, o);
   PairDetector det(s.a.faces, s.a.nv(), s.a.v0, s.b.faces, s.b.nv(), s.b.v0, o);
   std::vector<int> active;
   std::vector<std::uint8_t> act(s.a.nv(), 0);
@@ -130,12 +130,13 @@ TEST(PairDetector, RepeatedCallsWithFewMovedVerticesEqualBruteForce) {
     for (int v = round; v < s.a.nv(); v += 7)
       a1(v, 2) += 0.01 * (round % 2 == 0 ? 1 : -1);  // a pass's changed velocities
     SCOPED_TRACE(::testing::Message() << "round " << round);
-    const PairDetectResult ref = brute_force_detect_pair(s.ta, s.a.v0, a1, s.tb, s.b.v0, s.b.v1, o);
+    const PairDetectResult ref =
+        research::brute_force_detect_pair(s.ta, s.a.v0, a1, s.tb, s.b.v0, s.b.v1, o);
     expect_pair_equal(det.detect(s.a.v0, a1, s.b.v0, s.b.v1), ref);
   }
   det.rebuild(a1, s.b.v1);  // trees split on another shape: the same pairs
   expect_pair_equal(det.detect(s.a.v0, a1, s.b.v0, s.b.v1),
-                    brute_force_detect_pair(s.ta, s.a.v0, a1, s.tb, s.b.v0, s.b.v1, o));
+                    research::brute_force_detect_pair(s.ta, s.a.v0, a1, s.tb, s.b.v0, s.b.v1, o));
 }
 
 // Every pair within h by direct distances.

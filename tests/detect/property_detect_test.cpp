@@ -112,8 +112,8 @@ TEST(DetectProperty, NonFinitePositionsNameTheVertex) {
       expect_vertex_error([&] { (void)det.detect(s.v0, p); }, v, "detect t1");
       expect_vertex_error([&] { (void)det.proximity(p, 0.01 * s.scale); }, v, "proximity");
       expect_vertex_error([&] { det.rebuild(p); }, v, "rebuild");
-      expect_vertex_error([&] { (void)brute_force_detect(topo, s.v0, p); }, v, "oracle");
-      expect_same(det.detect(s.v0, s.v1), brute_force_detect(topo, s.v0, s.v1), 1e-4);
+      expect_vertex_error([&] { (void)research::brute_force_detect(topo, s.v0, p); }, v, "oracle");
+      expect_same(det.detect(s.v0, s.v1), research::brute_force_detect(topo, s.v0, s.v1), 1e-4);
 
       const int w = rng.integer(0, b.nv() - 1);
       Positions q = b.v0;
@@ -142,7 +142,7 @@ TEST(DetectProperty, BadThicknessOrToiToleranceIsAnInputErrorNamingTheOption) {
   Positions b = a;
   b.col(2).tail(3).setConstant(-1);  // the second triangle passes through the first
   const Topology topo(faces, 6);
-  ASSERT_GT(brute_force_detect(topo, a, b).ee.size(), 0u);
+  ASSERT_GT(research::brute_force_detect(topo, a, b).ee.size(), 0u);
   auto expect_option_error = [](auto&& call, const std::string& option) {
     try {
       call();
@@ -162,7 +162,8 @@ TEST(DetectProperty, BadThicknessOrToiToleranceIsAnInputErrorNamingTheOption) {
       expect_option_error([&] { PairDetector d(faces, 6, a, faces, 6, a, o); }, name);
       SelfDetector det(faces, 6, a, {});
       expect_option_error([&] { det.set_options(o); }, name);
-      expect_same(det.detect(a, b), brute_force_detect(topo, a, b), 1e-4);  // options unchanged
+      expect_same(det.detect(a, b), research::brute_force_detect(topo, a, b),
+                  1e-4);  // options unchanged
     }
   }
 }

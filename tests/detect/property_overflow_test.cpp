@@ -8,8 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "bvh/traversal.hpp"
 #include "core/checked_index.hpp"
-#include "detect/traversal.hpp"
 #include "property_scenes.hpp"
 
 namespace clothcd {

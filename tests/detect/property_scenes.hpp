@@ -375,8 +375,8 @@ inline std::size_t check_self_detect(const RandomScene& s, std::uint64_t seed,
     const double thickness = relative_thickness * s.scale;
     DetectOptions base;
     base.thickness = thickness;
-    const DetectResult ref = brute_force_detect(topo, s.v0, s.v1, base);
-    const DetectResult ref_b = brute_force_detect(topo, s.v0, v1b, base);
+    const DetectResult ref = research::brute_force_detect(topo, s.v0, s.v1, base);
+    const DetectResult ref_b = research::brute_force_detect(topo, s.v0, v1b, base);
     found += ref.vf.size() + ref.ee.size();
     for (const Config& c : exact_configs(thickness)) {
       SCOPED_TRACE(describe(c, thickness));
@@ -443,7 +443,8 @@ inline std::size_t check_pair_detect(const RandomScene& a, const RandomScene& b,
     const double thickness = relative_thickness * a.scale;
     DetectOptions o;
     o.thickness = thickness;
-    const PairDetectResult ref = brute_force_detect_pair(ta, a.v0, a.v1, tb, b.v0, b.v1, o);
+    const PairDetectResult ref =
+        research::brute_force_detect_pair(ta, a.v0, a.v1, tb, b.v0, b.v1, o);
     found += ref.vf_a_on_b.size() + ref.vf_b_on_a.size() + ref.ee.size();
     for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
       SCOPED_TRACE("pair build " + std::to_string(int(build)) + " thickness " +

@@ -51,8 +51,9 @@ void expect_same(const ProximityResult& r, const ProximityResult& ref) {
     EXPECT_EQ(r.ee[i].distance, ref.ee[i].distance);
 }
 
-std::vector<ProceduralScene> reuse_scenes() {
-  return {crumpled_sheet(8, 2), twisted_strip(30, 3), stacked_sheets(6)};
+std::vector<research::ProceduralScene> reuse_scenes() {
+  return {research::crumpled_sheet(8, 2), research::twisted_strip(30, 3),
+          research::stacked_sheets(6)};
 }
 
 TEST(ProximityReuse, EqualsAllPairsDistance) {
@@ -143,7 +144,7 @@ TEST(ProximityReuse, KeptAcrossRestrictedPasses) {
 // A CCD thickness at or above the reuse distance already gives boxes wide enough: the pairs are
 // kept all the same, and the collisions are those of a detector without reuse.
 TEST(ProximityReuse, KeptWhenTheThicknessAlreadyReachesTheDistance) {
-  const ProceduralScene s = crumpled_sheet(8, 2);
+  const research::ProceduralScene s = research::crumpled_sheet(8, 2);
   const Topology topo(s.faces, s.num_vertices);
   const Positions end = 0.5 * (s.v_t0 + s.v_t1);
   for (double reach : {kKept, 0.5 * kKept}) {
@@ -167,7 +168,7 @@ TEST(ProximityReuse, KeptWhenTheThicknessAlreadyReachesTheDistance) {
 }
 
 TEST(ProximityReuse, OffWhereItCannotHold) {
-  const ProceduralScene s = crumpled_sheet(8, 2);
+  const research::ProceduralScene s = research::crumpled_sheet(8, 2);
   const Topology topo(s.faces, s.num_vertices);
   const Positions end = 0.5 * (s.v_t0 + s.v_t1);
   const ProximityResult ref = brute_force_proximity(topo, end, kKept);
@@ -191,9 +192,9 @@ TEST(ProximityReuse, OffWhereItCannotHold) {
   }
   {
     SCOPED_TRACE("the unsound rules may cull close pairs: refused with a reuse distance");
-    for (auto rule : {research::UnsoundCulling::Cone, research::UnsoundCulling::Gated}) {
+    for (auto rule : {research::CullingRule::Cone, research::CullingRule::Gated}) {
       DetectOptions cone = o;
-      cone.research.unsound_culling = rule;
+      cone.research.culling = rule;
       EXPECT_THROW(SelfDetector(s.faces, s.num_vertices, s.v_t0, cone), InputError);
       SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
       EXPECT_THROW(det.set_options(cone), InputError);
@@ -220,7 +221,7 @@ TEST(ProximityReuse, OffWhereItCannotHold) {
 // the pairs it keeps still serve the proximity query: cones and reuse work together.
 TEST(ProximityReuse, SoundCullingKeepsWhatTheQueryNeeds) {
   std::uint64_t culled = 0, reused = 0;
-  for (const ProceduralScene& s : reuse_scenes()) {
+  for (const research::ProceduralScene& s : reuse_scenes()) {
     for (const double reuse : {0.002, kKept}) {
       SCOPED_TRACE(::testing::Message() << s.name << " reuse distance " << reuse);
       const Topology topo(s.faces, s.num_vertices);
@@ -339,7 +340,7 @@ TEST(ProximityLinks, LeavesLinkedPairsOut) {
 // The BVH build is fixed at construction: set_options with another one is refused, the same
 // build accepted.
 TEST(SetOptions, RefusesAnotherBuild) {
-  const ProceduralScene s = crumpled_sheet(4, 1);
+  const research::ProceduralScene s = research::crumpled_sheet(4, 1);
   DetectOptions o;
   o.build = BvhBuild::Patch;
   SelfDetector det(s.faces, s.num_vertices, s.v_t0, o);
@@ -352,7 +353,7 @@ TEST(SetOptions, RefusesAnotherBuild) {
 }
 
 TEST(ProximityReuse, RejectsBadDistances) {
-  const ProceduralScene s = crumpled_sheet(4, 1);
+  const research::ProceduralScene s = research::crumpled_sheet(4, 1);
   for (double d :
        {-1e-3, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     DetectOptions o;

@@ -18,8 +18,9 @@ namespace {
 // A grid of nu x nv quads over (u, v) in [0, 1]^2, each split into two triangles, with vertex
 // positions map(u, v) at t0 and map(u, v) + motion(u, v) at t1.
 using Map = std::function<Eigen::Vector3d(double, double)>;
-ProceduralScene grid(const char* name, int nu, int nv, const Map& at_t0, const Map& at_t1) {
-  ProceduralScene s;
+research::ProceduralScene grid(const char* name, int nu, int nv, const Map& at_t0,
+                               const Map& at_t1) {
+  research::ProceduralScene s;
   s.name = name;
   s.num_vertices = (nu + 1) * (nv + 1);
   s.v_t0.resize(s.num_vertices, 3);
@@ -43,11 +44,12 @@ ProceduralScene grid(const char* name, int nu, int nv, const Map& at_t0, const M
 
 // Runs Sound (both builds, every sound policy) against the brute force with the same options and
 // returns the nodes culled.
-std::uint64_t expect_sound_equals_brute_force(const ProceduralScene& s, double thickness) {
+std::uint64_t expect_sound_equals_brute_force(const research::ProceduralScene& s,
+                                              double thickness) {
   const Topology topo(s.faces, s.num_vertices);
   DetectOptions o;
   o.thickness = thickness;
-  const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1, o);
+  const DetectResult ref = research::brute_force_detect(topo, s.v_t0, s.v_t1, o);
   std::uint64_t culled = 0;
   for (BvhBuild build : {BvhBuild::Spatial, BvhBuild::Patch}) {
     for (ConePolicy policy : {ConePolicy::Provot, ConePolicy::Proposed, ConePolicy::Exact}) {
@@ -73,7 +75,7 @@ TEST(ThickSoundCulling, CullsAWavingSheetAndEqualsBruteForce) {
       return Eigen::Vector3d(u, v, 0.05 * std::sin(6 * u + phase) * std::cos(5 * v));
     };
   };
-  const ProceduralScene s = grid("waving sheet", 24, 24, wave(0.0), wave(0.3));
+  const research::ProceduralScene s = grid("waving sheet", 24, 24, wave(0.0), wave(0.3));
   for (double h : {1e-5, 1e-3}) {
     EXPECT_GT(expect_sound_equals_brute_force(s, h), 0u) << "thickness " << h;
   }
@@ -91,11 +93,11 @@ TEST(ThickSoundCulling, NearlyClosedFlatRingIsNotCulledAcrossItsGap) {
       return Eigen::Vector3d(r * std::cos(angle), r * std::sin(angle), lift);
     };
   };
-  const ProceduralScene s = grid("nearly closed ring", 64, 2, ring(0.0), ring(1e-4));
+  const research::ProceduralScene s = grid("nearly closed ring", 64, 2, ring(0.0), ring(1e-4));
   const Topology topo(s.faces, s.num_vertices);
   DetectOptions o;
   o.thickness = 5e-3;
-  const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1, o);
+  const DetectResult ref = research::brute_force_detect(topo, s.v_t0, s.v_t1, o);
   ASSERT_GT(ref.vf.size() + ref.ee.size(), 0u);  // the ends are within the thickness
   static_cast<void>(expect_sound_equals_brute_force(s, 5e-3));
   // Farther than the thickness: the same patches may be culled, and still nothing is lost.
@@ -114,7 +116,7 @@ TEST(ThickSoundCulling, BarelyInjectiveRampEqualsBruteForce) {
       return Eigen::Vector3d(r * std::cos(angle), r * std::sin(angle), pitch * u + shift);
     };
   };
-  const ProceduralScene s = grid("helical ramp", 64, 2, ramp(0.0), ramp(2e-4));
+  const research::ProceduralScene s = grid("helical ramp", 64, 2, ramp(0.0), ramp(2e-4));
   for (double h : {1e-3, 2e-2})
     static_cast<void>(expect_sound_equals_brute_force(s, h));
 }
@@ -134,10 +136,10 @@ TEST(ThickSoundCulling, FoldedLayersAndFineMeshesEqualBruteForce) {
       return Eigen::Vector3d(0.45 + radius * std::sin(a), v, radius * (1 - std::cos(a)));
     };
   };
-  const ProceduralScene folded = grid("folded layers", 24, 3, fold(1.0), fold(0.8));
+  const research::ProceduralScene folded = grid("folded layers", 24, 3, fold(1.0), fold(0.8));
   static_cast<void>(expect_sound_equals_brute_force(folded, 2e-3));
   auto flat = [](double z) { return [z](double u, double v) { return Eigen::Vector3d(u, v, z); }; };
-  const ProceduralScene fine = grid("fine mesh", 12, 12, flat(0.0), flat(1e-4));
+  const research::ProceduralScene fine = grid("fine mesh", 12, 12, flat(0.0), flat(1e-4));
   static_cast<void>(expect_sound_equals_brute_force(fine, 0.1));  // triangles 0.083 high
 }
 
@@ -145,7 +147,7 @@ TEST(ThickSoundCulling, FoldedLayersAndFineMeshesEqualBruteForce) {
 // boundary: the contour is clear, so only the corner clearance can refuse the cull.
 TEST(ThickSoundCulling, InteriorSliverIsNotCulled) {
   auto flat = [](double z) { return [z](double u, double v) { return Eigen::Vector3d(u, v, z); }; };
-  ProceduralScene s = grid("interior sliver", 16, 16, flat(0.0), flat(1e-5));
+  research::ProceduralScene s = grid("interior sliver", 16, 16, flat(0.0), flat(1e-5));
   // Vertex (8, 8) sits at (0.5, 0.5); its 1-ring includes the edge from (9, 8) to (9, 9), the
   // line u = 9/16. Move it to 1e-4 short of that line.
   const int v = 8 * 17 + 8;
@@ -154,7 +156,7 @@ TEST(ThickSoundCulling, InteriorSliverIsNotCulled) {
   const Topology topo(s.faces, s.num_vertices);
   DetectOptions o;
   o.thickness = 1e-3;
-  const DetectResult ref = brute_force_detect(topo, s.v_t0, s.v_t1, o);
+  const DetectResult ref = research::brute_force_detect(topo, s.v_t0, s.v_t1, o);
   ASSERT_GT(ref.vf.size() + ref.ee.size(), 0u);  // the vertex is within the thickness
   static_cast<void>(expect_sound_equals_brute_force(s, 1e-3));
 }

@@ -63,7 +63,7 @@ TEST(Experiment, FoldingSheetHasSelfCollisions) {
   const Topology topo(seq.faces, seq.num_vertices);
   std::size_t total = 0;
   for (int s = 0; s < seq.steps(); ++s) {
-    const DetectResult r = brute_force_detect(topo, seq.frames[s], seq.frames[s + 1]);
+    const DetectResult r = research::brute_force_detect(topo, seq.frames[s], seq.frames[s + 1]);
     total += r.vf.size() + r.ee.size();
   }
   EXPECT_GT(total, 0u) << "the test sequence must exercise the miss accounting";
@@ -105,7 +105,7 @@ TEST(Experiment, RowsPerStepAndConfigurationSoundEqualsReference) {
   ASSERT_EQ(ref.size(), std::size_t(seq.steps()) * 2);
   for (const auto& [key, r] : ref) {
     const DetectResult o =
-        brute_force_detect(topo, seq.frames[key.second], seq.frames[key.second + 1]);
+        research::brute_force_detect(topo, seq.frames[key.second], seq.frames[key.second + 1]);
     EXPECT_EQ(r->vf_collisions, double(o.vf.size())) << key.first << " step " << key.second;
     EXPECT_EQ(r->ee_collisions, double(o.ee.size())) << key.first << " step " << key.second;
     // The paper's narrow phase (no whole-triangle bound): its feature tests and NP culls.

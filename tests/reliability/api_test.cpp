@@ -34,7 +34,7 @@ void expect_contains(const std::string& msg, const std::vector<std::string>& par
 }
 
 TEST(DetectorInput, NonFinitePositionsAreRejected) {
-  const ProceduralScene s = crumpled_sheet(6, 1);
+  const research::ProceduralScene s = research::crumpled_sheet(6, 1);
   SelfDetector det(s.faces, s.num_vertices, s.v_t0);
   for (double bad :
        {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
@@ -48,13 +48,14 @@ TEST(DetectorInput, NonFinitePositionsAreRejected) {
   }
   // The detector still works after a rejected call.
   const DetectResult r = det.detect(s.v_t0, s.v_t1);
-  const DetectResult ref = brute_force_detect(Topology(s.faces, s.num_vertices), s.v_t0, s.v_t1);
+  const DetectResult ref =
+      research::brute_force_detect(Topology(s.faces, s.num_vertices), s.v_t0, s.v_t1);
   EXPECT_EQ(r.vf, ref.vf);
   EXPECT_EQ(r.ee, ref.ee);
 }
 
 TEST(DetectorInput, WrongVertexCountIsRejected) {
-  const ProceduralScene s = crumpled_sheet(6, 2);
+  const research::ProceduralScene s = research::crumpled_sheet(6, 2);
   SelfDetector det(s.faces, s.num_vertices, s.v_t0);
   const Positions fewer = s.v_t1.topRows(s.num_vertices - 1);
   expect_contains(error_of([&] { (void)det.detect(s.v_t0, fewer); }),
@@ -90,7 +91,7 @@ TEST(DetectorInput, EmptyMeshFindsNothing) {
 // Duplicate and zero-area faces are allowed (reported by mesh diagnostics, not rejected): the
 // detector must match the oracle on them under every culling mode, with times in [0, 1].
 TEST(DetectorInput, DuplicateAndDegenerateFacesMatchOracle) {
-  ProceduralScene s = crumpled_sheet(8, 3);
+  research::ProceduralScene s = research::crumpled_sheet(8, 3);
   const int n = s.num_vertices;
   s.faces.push_back(s.faces[10]);                                       // exact duplicate
   s.faces.push_back({s.faces[20][2], s.faces[20][1], s.faces[20][0]});  // flipped duplicate
@@ -105,7 +106,7 @@ TEST(DetectorInput, DuplicateAndDegenerateFacesMatchOracle) {
   }
   s.faces.push_back({n, n + 1, n + 2});
   const Topology topo(s.faces, n + 3);
-  const DetectResult ref = brute_force_detect(topo, v0, v1);
+  const DetectResult ref = research::brute_force_detect(topo, v0, v1);
   ASSERT_GT(ref.vf.size() + ref.ee.size(), 0u);
   for (Culling c : {Culling::None, Culling::Sound}) {
     DetectOptions o;

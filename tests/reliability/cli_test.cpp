@@ -30,7 +30,7 @@ using Files = std::vector<std::string>;
 // disk fails with ENOSPC) instead of killing it; `ulimit -f 1` allows 1024 bytes per file.
 const char* kDiskFull = "trap '' XFSZ; ulimit -f 1;";
 
-TriangleMesh frame(const ProceduralScene& s, const Positions& v) {
+TriangleMesh frame(const research::ProceduralScene& s, const Positions& v) {
   TriangleMesh m;
   m.faces = s.faces;
   for (Eigen::Index i = 0; i < v.rows(); ++i)
@@ -40,7 +40,7 @@ TriangleMesh frame(const ProceduralScene& s, const Positions& v) {
 
 // A crumpled sheet stepped into self-contact: t0.obj and t1.obj in the scratch folder.
 void write_step(const CliScratch& dir) {
-  const ProceduralScene s = crumpled_sheet(16, 7);
+  const research::ProceduralScene s = research::crumpled_sheet(16, 7);
   write_obj(dir / "t0.obj", frame(s, s.v_t0));
   write_obj(dir / "t1.obj", frame(s, s.v_t1));
 }
@@ -179,7 +179,7 @@ TEST(CliDetect, JsonHoldsTheDetectorsCollisionsExactly) {
   const auto j = nlohmann::json::parse(CliScratch::slurp(dir / "out.json"));
   const TriangleMesh m0 = read_mesh(dir / "t0.obj"), m1 = read_mesh(dir / "t1.obj");
   research::DetectOptions o;
-  o.research.unsound_culling = research::UnsoundCulling::Cone;
+  o.research.culling = research::CullingRule::Cone;
   o.research.verify = true;
   research::SelfDetector det(m0.faces, m0.num_vertices(), vertices_matrix(m0), o);
   const research::DetectResult want = det.detect(vertices_matrix(m0), vertices_matrix(m1));

@@ -77,11 +77,7 @@ struct RefitOptions {
   double thickness = 0.0;  ///< boxes grow by thickness / 2 on every side (rounded outwards)
   bool cones = true;       ///< compute the normal cones (box-only traversal skips them)
   ConePolicy policy = ConePolicy::Proposed;
-  /// Research reference, not for simulation: instead of `policy`, every node gets the optimal
-  /// cone of its descendant leaves' normal control directions (exact leaf caps). Slow: a node
-  /// costs time linear in its triangles (clothcd/research/options.hpp).
-  bool optimal_cones = false;
-  /// CCD refits with cones (and without optimal_cones) fit cones only to nodes of at least this
+  /// CCD refits with cones fit cones only to nodes of at least this
   /// many triangles: such a node whose child is smaller gives that child a valid cone of its
   /// triangles' normals computed at once (not `policy`'s), and the nodes below get none
   /// (cones() keeps their last values). For a traversal that tests no smaller node's cone.
@@ -89,6 +85,10 @@ struct RefitOptions {
   int cone_min_triangles = 0;
   bool operator==(const RefitOptions&) const = default;
 };
+
+namespace detail {
+struct OptimalCones;
+}
 
 class Bvh {
  public:
@@ -129,8 +129,8 @@ class Bvh {
   [[nodiscard]] int num_vertices() const { return num_vertices_; }
   /// Sum of the internal nodes' box surface areas over the leaves', at the last refit. A tree
   /// refit to shapes far from the one it was built on has ever looser boxes, and this ratio grows
-  /// with them (the multilayer garment on the kick: 6.1 built, 21 at frame 90, 8.1 rebuilt
-  /// there): the cue to rebuild. 1 when every box is flat to a point, infinite when only the
+  /// with them: the cue to rebuild (the simulator rebuilds at 1.5 times its value after a build,
+  /// docs/simulator.md 3.6). 1 when every box is flat to a point, infinite when only the
   /// leaves' are.
   [[nodiscard]] double box_area_ratio() const;
 
@@ -165,16 +165,32 @@ class Bvh {
   void refit(std::span<const Eigen::Vector3d> v, const RefitOptions& options);
 
  private:
+  // The research module's reference refits: the refits below with `optimal` set
+  // (src/bvh/optimal_cones.hpp).
+  friend struct detail::OptimalCones;
+  // The public refits; with `optimal`, every node's cone is the optimal cone of its descendant
+  // leaves' normal control directions (exact leaf caps) instead of options.policy's.
+  void refit_with(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
+                  const RefitOptions& options, bool optimal);
+  void refit_changed_with(std::span<const Eigen::Vector3d> v_t0,
+                          std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options,
+                          bool optimal);
+  void refit_moved_with(std::span<const Eigen::Vector3d> v_t0,
+                        std::span<const Eigen::Vector3d> v_t1, const RefitOptions& options,
+                        std::span<const std::uint8_t> moved, bool optimal);
+  void refit_static_with(std::span<const Eigen::Vector3d> v, const RefitOptions& options,
+                         bool optimal);
   template <class LeafFn, class PatchFn>
-  void refit_levels(const RefitOptions& options, std::span<const std::uint8_t> nodes, int min_count,
-                    LeafFn&& leaf, PatchFn&& patch);
-  // refit(v_t0, v_t1, options) of the flagged nodes only (all when `nodes` is empty; flags as
-  // nodes_holding gives them); the others keep their last refit's box and cone.
+  void refit_levels(const RefitOptions& options, bool optimal, std::span<const std::uint8_t> nodes,
+                    int min_count, LeafFn&& leaf, PatchFn&& patch);
+  // refit_with(v_t0, v_t1, options, optimal) of the flagged nodes only (all when `nodes` is
+  // empty; flags as nodes_holding gives them); the others keep their last refit's box and cone.
   void refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
-                   const RefitOptions& options, std::span<const std::uint8_t> nodes);
+                   const RefitOptions& options, bool optimal, std::span<const std::uint8_t> nodes);
   // refit_nodes() of the nodes above the flagged vertices (all when `moved` is empty).
   void refit_flagged(std::span<const Eigen::Vector3d> v_t0, std::span<const Eigen::Vector3d> v_t1,
-                     const RefitOptions& options, std::span<const std::uint8_t> moved);
+                     const RefitOptions& options, bool optimal,
+                     std::span<const std::uint8_t> moved);
   void forget_changes();
   void compute_flags(const Topology& topology);
   void build_tree(const Topology& topology, std::span<const Eigen::Vector3d> reference,
@@ -193,11 +209,13 @@ class Bvh {
   std::vector<int> contour_offsets_;  // CSR per node
   std::vector<int> contour_vertices_;
   std::vector<NormalCone> cones_;
-  // Unit Bernstein control directions of each leaf, by prim position (optimal_cones only).
+  // Unit Bernstein control directions of each leaf, by prim position (optimal cones only).
   std::vector<Eigen::Vector3d> control_dirs_;
   std::vector<std::uint8_t> degenerate_;
-  // What the last refit_changed() fitted (cleared by any other refit).
+  // What the last refit_changed() fitted (cleared by any other refit), and whether with
+  // optimal cones.
   std::optional<RefitOptions> changed_options_;
+  bool changed_optimal_ = false;
   std::vector<Eigen::Vector3d> changed_t0_, changed_t1_;
 };
 

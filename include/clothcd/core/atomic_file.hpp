@@ -9,8 +9,8 @@
 ///
 /// A killed process leaves the target old or new, never partial, in any case. With `Durability::
 /// sync` the temporary file is also flushed to the disk (fsync) before the rename, so that the
-/// same holds after a machine crash or power loss; it costs about 10 ms per file on this machine,
-/// so it is for files that are a commit point others rely on (the simulator's frames, states and
+/// same holds after a machine crash or power loss; that costs a disk flush per file, so it is
+/// for files that are a commit point others rely on (the simulator's frames, states and
 /// manifest), not for every output.
 
 #include <filesystem>

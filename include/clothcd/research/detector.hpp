@@ -41,7 +41,7 @@ class SelfDetector : public clothcd::SelfDetector {
   /// configurations that keep it. time_refit is each configuration's own refit; time_traverse
   /// and time_narrow are NaN (shared work; detect() measures them). The configurations may
   /// differ only in policy, culling, cull_min_triangles and the research options'
-  /// unsound_culling and optimal_cones; reuse_distance must be 0, verify off, the build the
+  /// culling and optimal_cones; reuse_distance must be 0, verify off, the build the
   /// detector's, at most 64 of them and no active restriction. Throws InputError otherwise. The
   /// detector's own options are left as they were.
   [[nodiscard]] std::vector<clothcd::DetectResult> detect_each(

@@ -17,10 +17,11 @@
 
 namespace clothcd::research {
 
-/// The rule a detector with these options runs: research.unsound_culling when set, else culling.
+/// The rule a detector with these options runs: research.culling when set, else culling's.
 [[nodiscard]] CullingRule culling_rule(const DetectOptions& options);
-/// Sets culling and research.unsound_culling so that culling_rule(options) == rule (an unsound
-/// rule leaves culling at Culling::None).
+/// Sets culling and research.culling so that culling_rule(options) == rule: culling alone for
+/// the product's rules (research.culling unset), research.culling for an unsound rule (culling
+/// then Culling::None).
 void set_culling_rule(DetectOptions& options, CullingRule rule);
 /// The cones a detector with these options computes: Optimal when research.optimal_cones is set,
 /// else policy.
@@ -28,8 +29,6 @@ void set_culling_rule(DetectOptions& options, CullingRule rule);
 /// Sets policy and research.optimal_cones so that cone_rule(options) == rule (Optimal leaves
 /// policy as it is).
 void set_cone_rule(DetectOptions& options, ConeRule rule);
-/// The same for a Bvh refit: policy and optimal_cones.
-void set_cone_rule(RefitOptions& options, ConeRule rule);
 
 [[nodiscard]] std::string_view to_string(CullingRule rule);
 [[nodiscard]] std::string_view to_string(ConeRule rule);

@@ -9,33 +9,38 @@
 /// tool, the Python module and the experiment spell them.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "clothcd/detect/types.hpp"
 
 namespace clothcd::research {
 
-/// Every culling rule the measurements compare, as one value: Culling::None and Sound, and the
-/// unsound rules of UnsoundCulling (set_culling_rule in clothcd/research/names.hpp).
-enum class CullingRule { None, Cone, Gated, Sound };
+/// Every culling rule the measurements compare, as one value: Culling::None and Sound, and two
+/// rules that can miss collisions (docs/detect.md), for measuring how much the paper's rule culls
+/// and what it misses against Sound, which finds all that None finds.
+enum class CullingRule {
+  None,   ///< Culling::None
+  Cone,   ///< unsound: the paper's literal rule, skip a node's self test when its cone is below
+          ///< pi/2. Misses contacts between parts of a node that face the same way without
+          ///< touching along an edge (two stacked sheets) and within a patch that winds over itself
+  Gated,  ///< unsound: the cone rule on edge-connected nodes only. Still misses contacts: a
+          ///< connected patch can wind over itself (winding_strip in
+          ///< clothcd/research/procedural.hpp)
+  Sound,  ///< Culling::Sound
+};
+/// Whether `rule` can miss collisions (Cone, Gated).
+[[nodiscard]] constexpr bool unsound(CullingRule rule) {
+  return rule == CullingRule::Cone || rule == CullingRule::Gated;
+}
 /// ConePolicy's three policies, and the optimal reference cones (Options::optimal_cones).
 enum class ConeRule { Provot, Proposed, Exact, Optimal };
 
-/// Culling rules that can miss collisions (docs/detect.md): for measuring how much the paper's
-/// rule culls and what it misses against Culling::Sound, which finds all that Culling::None finds.
-enum class UnsoundCulling {
-  None,   ///< no override: DetectOptions::culling applies
-  Cone,   ///< the paper's literal rule: skip a node's self test when its cone is below pi/2.
-          ///< Misses contacts between parts of a node that face the same way without touching
-          ///< along an edge (two stacked sheets) and within a patch that winds over itself
-  Gated,  ///< the cone rule on edge-connected nodes only. Still misses contacts: a connected
-          ///< patch can wind over itself (winding_strip in clothcd/research/procedural.hpp)
-};
-
 struct Options {
-  /// Overrides DetectOptions::culling when not None (the detector then runs this rule). Refused
-  /// with a reuse distance: an unsound rule may cull the pairs it keeps.
-  UnsoundCulling unsound_culling = UnsoundCulling::None;
+  /// When set, the rule the detector runs instead of DetectOptions::culling's; the unsound rules
+  /// are set here only (set_culling_rule in clothcd/research/names.hpp). An unsound rule is
+  /// refused with a reuse distance: it may cull the pairs the distance keeps.
+  std::optional<CullingRule> culling;
   /// Optimal node cones (the minimal cone of every descendant triangle's normal control
   /// directions, from exact leaf caps) instead of DetectOptions::policy's merges: the reference
   /// the policies are measured against. A node's cone costs time linear in its triangles, so a
@@ -43,8 +48,8 @@ struct Options {
   bool optimal_cones = false;
   /// Also run the unculled traversal and narrow phase on the same step and report in
   /// DetectResult::verification what the culled detection missed. The step then costs about a
-  /// culled and an unculled detection together. Nothing is run with Culling::None and no unsound
-  /// rule.
+  /// culled and an unculled detection together. Nothing is run when the rule run is
+  /// CullingRule::None.
   bool verify = false;
   bool operator==(const Options&) const = default;
 };

@@ -6,19 +6,19 @@
 
 #include "clothcd/detect/detector.hpp"
 
-namespace clothcd {
+namespace clothcd::research {
 
 /// All pairs of features that touch during v_t0 -> v_t1; `active` (optional, per face) restricts
 /// to pairs with at least one feature on an active face. Stats hold the test counts only.
-[[nodiscard]] DetectResult brute_force_detect(const Topology& topology, const Positions& v_t0,
-                                              const Positions& v_t1,
-                                              const DetectOptions& options = {},
-                                              std::span<const std::uint8_t> active = {});
+[[nodiscard]] clothcd::DetectResult brute_force_detect(const Topology& topology,
+                                                       const Positions& v_t0, const Positions& v_t1,
+                                                       const clothcd::DetectOptions& options = {},
+                                                       std::span<const std::uint8_t> active = {});
 
 /// Brute-force two-mesh reference of PairDetector.
 [[nodiscard]] PairDetectResult brute_force_detect_pair(const Topology& a, const Positions& a_t0,
                                                        const Positions& a_t1, const Topology& b,
                                                        const Positions& b_t0, const Positions& b_t1,
-                                                       const DetectOptions& options = {});
+                                                       const clothcd::DetectOptions& options = {});
 
-}  // namespace clothcd
+}  // namespace clothcd::research

@@ -17,7 +17,7 @@
 
 #include "clothcd/detect/detector.hpp"
 
-namespace clothcd {
+namespace clothcd::research {
 
 struct ProceduralScene {
   std::string name;
@@ -43,4 +43,4 @@ struct ProceduralScene {
 [[nodiscard]] Positions smooth_perturbation(const Positions& positions, double amplitude,
                                             double wavelength, std::uint64_t seed);
 
-}  // namespace clothcd
+}  // namespace clothcd::research

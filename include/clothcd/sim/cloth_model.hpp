@@ -80,9 +80,8 @@ class ClothModel {
   /// the vertices of each stitch term, and vertices joined by a chain of stitches that lie
   /// within one mean edge length of each other in the initial shape. A seam sews panels by
   /// vertex-to-edge stitches whose allowances overlap, so faces a few millimetres apart across
-  /// a seam touch or cross by construction (the multilayer drape's 22 "crossings" at frame 0 are
-  /// all such pairs); a welded mesh would make them neighbours. The distance bound keeps the
-  /// two ends of a long seam (one chain) apart.
+  /// a seam touch or cross by construction; a welded mesh would make them neighbours. The distance
+  /// bound keeps the two ends of a long seam (one chain) apart.
   [[nodiscard]] const std::vector<std::pair<int, int>>& seam_links() const { return seam_links_; }
   [[nodiscard]] const std::vector<Vec3>& initial_positions() const { return initial_; }
 

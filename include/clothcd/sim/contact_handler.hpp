@@ -28,8 +28,8 @@ struct ContactOptions {
   int zone_rounds = 30;         ///< impact-zone rounds before giving up
   /// Share of the overlap d-hat - d that repulsion removes per substep.
   double repulsion_fraction = 0.1;
-  /// Gauss-Seidel sweeps of the repulsion impulses (the first one also applies friction). On
-  /// multilayer-kick frames 1-3, 20 instead of 1 left 31,521 instead of 154,054 CCD hits.
+  /// Gauss-Seidel sweeps of the repulsion impulses (the first one also applies friction). More
+  /// sweeps leave the CCD passes far fewer hits to settle.
   int repulsion_sweeps = 20;
   /// Repulsion keeps each cloth vertex of a contact (weight >= 0.05) from approaching the other
   /// side, then tops up the contact as a whole; false: the contact's single impulse spread by
@@ -52,9 +52,8 @@ struct ContactOptions {
   bool full_passes = false;
   /// Cloth vertices found inside the body (behind a body face that one of their faces crosses)
   /// move out along that face's normal by up to this much per substep (m; 0: off, the default).
-  /// 2 mm from frame 0 undid the body crossings of dress-kick and of multilayer-kick's frames
-  /// 51-53, but resumed inside multilayer-kick's deep tangle of frame 72 it gave 803 and 813
-  /// crossings where the run without it had 619.
+  /// Off by default: it undoes shallow body crossings, but inside a deep tangle it can add
+  /// crossings.
   double untangle_step = 0.0;
   /// Impact zones touching the body or a pin follow the affine motion nearest their anchors'
   /// velocities where the anchors determine one (not flat, strain |h A| under 0.2), else the
@@ -65,13 +64,12 @@ struct ContactOptions {
   /// (`pointwise_repulsion`); lighter ones are left to the contact's own top-up impulse.
   double pointwise_weight = 0.05;
   /// How closely the CCD kernels refine a hit's time of impact (fraction of the substep, on the
-  /// early side). The response uses the geometry at toi only for its normal and weights; on
-  /// dress-rumba frame 1, 1e-4 took 5.5 s and 0.05 took 3.6 s per frame.
+  /// early side). The response uses the geometry at toi only for its normal and weights, so a
+  /// coarse tolerance saves kernel time without changing what the response needs.
   double toi_tolerance = 0.05;
   /// Bisections of the CCD distance filter before a kernel runs (DetectOptions::
   /// distance_filter_depth): each level costs at most 2^level distance evaluations, far less
-  /// than a kernel; on multilayer-kick frame 2 a restricted pass ran about 16,000 kernels with
-  /// the whole-step bound alone and about 500 with 6 levels.
+  /// than a kernel, and on resting layers each level spares many kernels.
   int distance_filter_depth = 6;
   /// Projected Gauss-Seidel sweeps per CCD pass at most (the inelastic projection) ...
   int projection_sweeps = 100;
@@ -84,10 +82,10 @@ struct ContactOptions {
   int margin_rounds = 5;
   /// Node culling of the self CCD: Culling::Sound (the default) or Culling::None; the unsound
   /// cone rules are refused by the scene parser. Both find the same pairs, so the motion is
-  /// bitwise the same (tested); only the time and the figures of SelfCcdFigures differ. On the
-  /// garment scenes the sound culling removes 2-18% of a full pass's triangle pair tests and
-  /// costs no more than it saves (docs/results/in_situ.md); most of the remaining tests are
-  /// between layers or folds that really are close, which no normal cone can clear.
+  /// bitwise the same (tested); only the time and the figures of SelfCcdFigures differ
+  /// (docs/results/in_situ.md compares them on the garment scenes): most of the triangle pair
+  /// tests left are between layers or folds that really are close, which no normal cone can
+  /// clear.
   Culling culling = Culling::Sound;
   /// The normal cones the sound culling uses (no effect without culling): Provot, Proposed or
   /// Exact. Again only the time and the figures change, never the motion.

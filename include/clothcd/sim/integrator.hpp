@@ -39,10 +39,9 @@ struct SolverOptions {
   double pcg_tolerance = 1e-3;
   /// With contact constraints or couplings in the solve, the first solve stops at this relative
   /// residual (or pcg_tolerance, if larger): it only decides which of them to let go, and the
-  /// solve redone after that reaches pcg_tolerance. On multilayer-rumba frames 61-64 a complete
-  /// first solve (73 iterations a substep) was followed by a redo of 43 in every substep; with
-  /// 1e-2 they took 18 and 64 (docs/simulator.md 2.1). At or below pcg_tolerance: the
-  /// complete first solve, redone only when something was let go.
+  /// solve redone after that reaches pcg_tolerance: a complete first solve is mostly wasted when
+  /// a redo follows anyway (docs/simulator.md 2.1). At or below pcg_tolerance: the complete
+  /// first solve, redone only when something was let go.
   double release_tolerance = 1e-2;
   /// The PCG tolerance of the substeps of a fast frame (ClothSolver::step's `fast`): one that
   /// the substep rule gave more than its minimum of substeps, so that each substep moves the body

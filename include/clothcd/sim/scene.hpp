@@ -29,8 +29,7 @@ struct SubstepRule {
   /// length.
   double cloth_displacement = 0.0;
   /// Which cloth speed the cloth rule uses: this quantile of the vertex speeds (1: the fastest).
-  /// Below 1, a few vertices thrown fast by the response (on the multilayer 0.3% of them moved
-  /// faster than 1 m/s while the median was 0.07 m/s) no longer set the substep count for all.
+  /// Below 1, a few vertices thrown fast by the response do not set the substep count for all.
   double cloth_speed_quantile = 1.0;
   /// n = clamp(max(ceil(body displacement in the frame / displacement),
   ///               ceil(cloth speed * frame time / cloth_displacement)), min, max)

@@ -49,8 +49,7 @@ class ContactDetectors {
   // The self detector's box area ratio after the first full CCD pass since its tree was built
   // (0: not yet seen). The detector's tree keeps the splits of the shape it was built on; once
   // its boxes have loosened past that (FittedTree::loosened), a substep rebuilds it on its start
-  // (the same pairs, faster: multilayer-kick frame 90, the first pass took 96 ms on the frame-0
-  // tree, 58 ms rebuilt).
+  // (the same pairs, faster).
   double self_fit_ = 0.0;
   std::optional<PairDetector> body_;
   std::array<double, 2> body_fit_{0.0, 0.0};  // cloth's and body's tree (0: not yet measured)

@@ -63,8 +63,8 @@ CollisionStats resolve_zones(const ContactGeometry& g, const ContactOptions& opt
     Vec3 point, velocity;
   };
   std::vector<Anchor> anchors;
-  // Per substep: 0.1 mm with the scenes' settings (dress-rumba frames 1-12: no body crossing
-  // and max stretch 0.96, against 25 crossing pairs and 1.2-3.2 without it).
+  // Per substep: 0.1 mm with the scenes' settings; without the push, zones touching the body
+  // leave body crossings behind and stretch the cloth.
   const double anchor_push = std::max(2.0 * opt.ccd_thickness, 0.1 * opt.thickness);
   std::vector<int> vertex_anchor_count(n, 0);
   std::vector<int> active = flagged(changed);
@@ -146,14 +146,10 @@ CollisionStats resolve_zones(const ContactGeometry& g, const ContactOptions& opt
       // nothing inside it can collide: free zones move rigidly and keep their momentum and
       // angular momentum (Provot 1997); zones touching the body or a pin take the affine motion
       // closest to the body's velocities at the points they touch (and the pins') where those
-      // fix one, else the rigid one. Affine, multilayer-kick held frames 67-70 where rigid
-      // zones gave up (a body that bends is not rigid under a zone). Fitted at the cloth
-      // vertices instead, each given its contacts' body velocity, the fit was off wherever a
-      // body point touched a long cloth edge or face: on multilayer-kick frame 69 (stretch 12)
-      // one contact anchored vertices 12 cm apart to one velocity on a turning leg, the fit
-      // missed the anchors by 1.65 mm per substep, and the zones gave up (312 body pairs; 104
-      // with this). Letting each vertex follow its own anchor instead bent the zone, and on the
-      // multilayer the zone rounds then stalled on self hits inside it.
+      // fix one, else the rigid one (a body that bends is not rigid under a zone). The fit is at
+      // the body points, not at the cloth vertices: one contact on a long cloth edge or face
+      // would give vertices far apart one velocity. Each vertex following its own anchor would
+      // bend the zone, and the zone rounds would stall on self hits inside it.
       std::vector<Vec3> points, velocities;
       std::vector<double> weights;
       for (int i : m) {

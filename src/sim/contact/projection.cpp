@@ -11,9 +11,7 @@ namespace clothcd::sim::detail {
 // i.e. close to the mass-weighted nearest velocities that satisfy every impact found so far. A
 // pair hit again keeps its earlier constraints beside the new one, so the linearization's errors
 // are fixed by accumulation instead of by the pair flipping between normals. Resolving each
-// pass's hits alone, as before, undid earlier passes' work: on multilayer-kick frames 1-3 the
-// rigid zones then ran in every substep and the frames ended with 120 / 243 / 363 crossing
-// pairs, against 0 zones and 0 crossings with this.
+// pass's hits alone would undo earlier passes' work and leave the impact zones to do it.
 void ImpactProjection::project(const std::vector<Contact>& hits, std::span<Vec3> v,
                                std::vector<std::uint8_t>& touched) {
   for (const Contact& c : hits) {

@@ -135,10 +135,9 @@ void ProximityContacts::repel(std::span<Vec3> v) const {
 // target; the weighted sum of these is the contact's own condition, which the caller then tops
 // up for the light-weight vertices left out. Why: the contact's single impulse, spread by weight
 // over inverse mass, gives the vertex nearest the contact point a velocity change larger than
-// the contact's deficit. A collar vertex already stopped by its own body contact was thrown off
-// the shoulder at 0.73 m/s because its face's other two vertices still fell onto a body vertex;
-// the membrane pulled it back, and the collar shook at up to 5 m/s (multilayer-rumba frames 1-3,
-// docs/simulator.md). Returns whether an impulse was applied.
+// the contact's deficit: a vertex already stopped by its own body contact would be thrown off
+// because its face's other two vertices still fall onto a body vertex, and the membrane would
+// pull it back (docs/simulator.md 3.1). Returns whether an impulse was applied.
 bool ProximityContacts::repel_pointwise(const Contact& c, double target, bool friction,
                                         std::span<Vec3> v) const {
   // Side 0: c_k > 0; side 1: c_k < 0. A body side acts as one point: its weighted velocity.

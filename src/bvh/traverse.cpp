@@ -1,11 +1,12 @@
-// The public traversals (clothcd/bvh/traverse.hpp) on the detectors' traversal template, without
-// culling or active restriction: lives beside that private template.
+// The public traversals (clothcd/bvh/traverse.hpp): the module's traversal template
+// (traversal.hpp, which the detectors run with their culling) without culling or active
+// restriction.
 
 #include "clothcd/bvh/traverse.hpp"
 
 #include <tbb/enumerable_thread_specific.h>
 
-#include "traversal.hpp"
+#include "bvh/traversal.hpp"
 
 namespace clothcd {
 namespace {

@@ -26,8 +26,8 @@
 #include <utility>
 #include <vector>
 
+#include "bvh/traversal.hpp"
 #include "clothcd/bvh/bvh.hpp"
-#include "traversal.hpp"
 
 namespace clothcd::detail {
 
