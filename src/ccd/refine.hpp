@@ -19,4 +19,10 @@ namespace clothcd::ccd_detail {
 [[nodiscard]] double refine_time_of_impact(const EdgeEdgeQuery& q, const CcdOptions& opt, double lo,
                                            double hi);
 
+/// Whether [lo, hi] (widened outwards to opt.toi_tolerance's dyadic grid) holds a box the
+/// inclusion solver cannot reject (or the search ran out of boxes): false proves that the
+/// features stay farther apart than opt.thickness over [lo, hi].
+[[nodiscard]] bool may_touch(const VertexFaceQuery& q, const CcdOptions& opt, double lo, double hi);
+[[nodiscard]] bool may_touch(const EdgeEdgeQuery& q, const CcdOptions& opt, double lo, double hi);
+
 }  // namespace clothcd::ccd_detail

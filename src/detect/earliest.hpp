@@ -22,6 +22,7 @@
 #include <limits>
 #include <span>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -132,7 +133,7 @@ class EarliestSearch {
       e.ids = h.ids;
       e.vertex_on_b = h.vertex_on_b;
       if (!(earliest_key(e) < earliest_key(best))) break;
-      if (tolerance_ < kernel_.toi_tolerance) e.toi = refine(h, fine);
+      if (tolerance_ < kernel_.toi_tolerance) e.toi = refine(h, fine, best.toi);
       if (earliest_key(e) < earliest_key(best)) best = e;
     }
     hits_.clear();
@@ -149,24 +150,27 @@ class EarliestSearch {
     bool vertex_on_b;
     std::array<int, 2> ids;
   };
-  // A hit's time at the fine tolerance: the kernel's own where it is no earlier than the
-  // coarse time (the zero-thickness fast path certifies it from the coplanarity cubic, tighter
-  // than any box search); where the kernel ran out of boxes (its time is then its earliest open
-  // one), the bisection from the coarse time.
-  [[nodiscard]] double refine(const Hit& h, const CcdOptions& fine) const {
-    // A coarse time is within its tolerance of a box the solver cannot reject, unless its search
-    // ran out of boxes (then it is only a lower bound): bisect up to the step's end.
-    const double hi = 1.0;
-    if (h.kind == EarliestImpact::Kind::VertexFace) {
-      const VertexFaceQuery q = query_vf(h);
-      const CcdResult k = vertex_face_ccd(q, fine);
-      if (settled(k, h, fine)) return k.toi;
-      return ccd_detail::refine_time_of_impact(q, fine, h.toi, hi);
-    }
-    const EdgeEdgeQuery q = query_ee(h);
-    const CcdResult k = edge_edge_ccd(q, fine);
-    if (settled(k, h, fine)) return k.toi;
-    return ccd_detail::refine_time_of_impact(q, fine, h.toi, hi);
+  // A hit's time at the fine tolerance, or `cap` (the best time so far) where it cannot come
+  // before it: one existence query over [coarse time, cap] settles most of the hits that lose
+  // (a thickness makes many pairs meet at nearly one time). Then at zero thickness the kernel's
+  // own fine search, where it is no earlier than the coarse time and within its box budget (the
+  // fast path certifies it from the coplanarity cubic, tighter than any box search); otherwise,
+  // and where a thickness makes that search run out of boxes, the bisection.
+  [[nodiscard]] double refine(const Hit& h, const CcdOptions& fine, double cap) const {
+    const auto one = [&](const auto& q) {
+      if (!ccd_detail::may_touch(q, fine, h.toi, cap)) return cap;
+      if (fine.thickness == 0) {
+        CcdResult k;
+        if constexpr (std::is_same_v<std::decay_t<decltype(q)>, VertexFaceQuery>) {
+          k = vertex_face_ccd(q, fine);
+        } else {
+          k = edge_edge_ccd(q, fine);
+        }
+        if (settled(k, h, fine)) return std::min(k.toi, cap);
+      }
+      return std::min(cap, ccd_detail::refine_time_of_impact(q, fine, h.toi, cap));
+    };
+    return h.kind == EarliestImpact::Kind::VertexFace ? one(query_vf(h)) : one(query_ee(h));
   }
   // Whether the kernel's fine time stands: a hit, no earlier than the coarse time, within its
   // box budget (an exhausted search reports its earliest open time instead).
