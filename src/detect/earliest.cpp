@@ -98,8 +98,7 @@ EarliestImpact SelfCore::earliest_impact(PointsIn p0, PointsIn p1, const Earlies
                          x1[a[0]], x1[a[1]], x1[b[0]], x1[b[1]]};
   };
   EarliestSearch search(ccd_context().ccd, eo.toi_tolerance, make_vf, make_ee);
-  // A window's settings replace the detector's for its detection only: its contact distance and
-  // time tolerance, and nothing kept for later calls (pairs for reuse, the traversal's front).
+  // A window's settings (window_options) replace the detector's for its detection only.
   const DetectOptions saved = opt;
   const Rule saved_rule = cull;
   struct Restore {
@@ -114,17 +113,12 @@ EarliestImpact SelfCore::earliest_impact(PointsIn p0, PointsIn p1, const Earlies
   } restore{*this, saved, saved_rule};
   return search_windows(
       first, rounding_slack(x0, x1), search, [&](double t, double slack, DetectStats& stats) {
-        opt = saved;
+        opt = window_options(saved, slack, search.kernel().toi_tolerance);
         // A short window's boxes are small: cones would cost a refit of their own and cull
-        // little, so its traversal tests boxes only.
+        // little, so its traversal tests boxes only. Its filters pick its hits, which the step's
+        // kernels time; the step's own hits come with their coarse times.
         cull = t < 1 ? Rule::None : saved_rule;
-        opt.thickness = saved.thickness + slack;
-        // A window's filters pick its hits, which the step's kernels time; the step's own hits
-        // come with their coarse times.
         window_filters_only = t < 1;
-        opt.toi_tolerance = search.kernel().toi_tolerance;
-        opt.reuse_distance = 0;
-        opt.reuse_front = false;
         if (t < 1) interpolate(x0, x1, t, xt);
         const DetectResult r = detect(std::span<const Eigen::Vector3d>(x0),
                                       std::span<const Eigen::Vector3d>(t < 1 ? xt : x1));

@@ -69,6 +69,18 @@ inline void interpolate(std::span<const Eigen::Vector3d> x0, std::span<const Eig
   return std::tuple(e.toi, e.kind == EarliestImpact::Kind::None, e.kind, e.vertex_on_b, e.ids);
 }
 
+/// The detector's options `o` for a window's detection: the contact distance plus the window's
+/// rounding allowance, the step kernels' coarse time tolerance, and nothing kept for later calls
+/// (pairs for reuse, the traversal's front).
+[[nodiscard]] inline DetectOptions window_options(DetectOptions o, double slack,
+                                                  double toi_tolerance) {
+  o.thickness += slack;
+  o.toi_tolerance = toi_tolerance;
+  o.reuse_distance = 0;
+  o.reuse_front = false;
+  return o;
+}
+
 /// Adds a window's counters and times into the query's.
 void add_stats(const DetectStats& window, DetectStats& total);
 

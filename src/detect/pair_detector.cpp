@@ -370,11 +370,8 @@ struct PairDetector::Impl {
     } restore{*this, saved};
     return detail::search_windows(
         first, slack, search, [&](double t, double sl, DetectStats& stats) {
-          opt = saved;
-          opt.thickness = saved.thickness + sl;
-          opt.toi_tolerance = search.kernel().toi_tolerance;
+          opt = detail::window_options(saved, sl, search.kernel().toi_tolerance);
           window_filters_only = t < 1;
-          opt.reuse_front = false;
           if (t < 1) {
             detail::interpolate(x[0], x[1], t, at);
             detail::interpolate(x[2], x[3], t, bt);
