@@ -308,7 +308,8 @@ TEST(NpBatchData, QueuedPairsGiveTheScalarResults) {
       o.np_filter = np;
       o.fast_path = fast;
       const detail::FeatureContext ctx = detail::ccd_context(f.topo, f.x0, f.x1, o, sorted);
-      ASSERT_TRUE(ctx.batched_np());
+      ASSERT_NE(ctx.plan.batch, detail::FeatureFilter::None);
+      ASSERT_NE(ctx.plan.batch, detail::FeatureFilter::Distance);
       expect_queued_equal_scalar(ctx, c, 1);
     }
   }
@@ -334,8 +335,7 @@ TEST(NpBatchData, QueuedPairsGiveTheScalarResultsAtAThickness) {
       o.distance_filter_depth = depth;
       o.toi_tolerance = 0.05;
       const detail::FeatureContext ctx = detail::ccd_context(f.topo, f.x0, x1, o);
-      ASSERT_TRUE(ctx.batched());
-      ASSERT_FALSE(ctx.batched_np());
+      ASSERT_EQ(ctx.plan.batch, detail::FeatureFilter::Distance);
       const Tested t = expect_queued_equal_scalar(ctx, c, 16);
       const detail::FeatureCounters& n = t.counters;
       // The filter culls most pairs but not all; the thicker step has collisions.
