@@ -55,10 +55,10 @@ struct LoopBuffers {
 };
 
 /// Runs `features(f, g, out)` on every pair of `pairs` that the plan keeps, `out` being the
-/// calling thread's buffer (a type derived from LoopBuffers). `fetch(f)` is called for the
-/// faces a few pairs ahead: the loop waits on memory, a pair's records sitting at scattered
-/// places. Counts the pairs past the box test in out.c.triangle_pairs and the Swept filter's
-/// culls in out.c.faces_apart.
+/// calling thread's buffer (a type derived from LoopBuffers). `fetch(f, g)` is called for the
+/// faces of the pair a few pairs ahead (it must be inlined: see SelfCore::fetch): the loop waits on
+/// memory, a pair's records sitting at scattered places. Counts the pairs past the box test in
+/// out.c.triangle_pairs and the Swept filter's culls in out.c.faces_apart.
 template <class Local, class Fetch, class Features>
 void pair_loop(const PairList& pairs, const LoopSide& a, const LoopSide& b, const LoopPlan& plan,
                tbb::enumerable_thread_specific<Local>& locals, Fetch&& fetch, Features&& features) {
@@ -71,10 +71,6 @@ void pair_loop(const PairList& pairs, const LoopSide& a, const LoopSide& b, cons
     if (!a.blocks.empty()) return a.blocks[f].face_overlaps(b.blocks[g]);
     return overlap(a.fboxes[f], b.fboxes[g]);
   };
-  const auto ahead = [&](std::span<const FacePair> piece, std::size_t k) {
-    if (k + kFar < piece.size()) fetch(piece[k + kFar].first, piece[k + kFar].second);
-  };
-  const bool batches = plan.filter != TriangleFilter::None || plan.near != nullptr;
   // Pairs [k0, k1) of a piece whose first pair is pair `first` of the list: the box test and
   // the queueing of the pairs past it, the filter on them at once, then their features.
   const auto chunk = [&](std::size_t first, std::span<const FacePair> piece, std::size_t k0,
@@ -83,7 +79,9 @@ void pair_loop(const PairList& pairs, const LoopSide& a, const LoopSide& b, cons
     FaceBoundBatch& bd = out.bound;
     std::array<bool, kBatch> past{};
     for (std::size_t k = k0; k < k1; ++k) {
-      ahead(piece, k);
+      // Written here, not in a helper: a function of prefetches alone counts as free of side
+      // effects, and the compiler drops its calls.
+      if (k + kFar < piece.size()) fetch(piece[k + kFar].first, piece[k + kFar].second);
       const auto [f, g] = piece[k];
       const std::size_t s = k - k0;
       ap.slot[s] = bd.slot[s] = -1;
@@ -139,20 +137,9 @@ void pair_loop(const PairList& pairs, const LoopSide& a, const LoopSide& b, cons
                       Local& out = locals.local();
                       for (std::size_t p = r.begin(); p != r.end(); ++p) {
                         const std::span<const FacePair> piece = pieces[p].pairs;
-                        if (batches) {
-                          for (std::size_t k0 = 0; k0 < piece.size(); k0 += kBatch) {
-                            chunk(pieces[p].first, piece, k0, std::min(piece.size(), k0 + kBatch),
-                                  out);
-                          }
-                          continue;
-                        }
-                        // Nothing to batch: each pair straight to its features.
-                        for (std::size_t k = 0; k < piece.size(); ++k) {
-                          ahead(piece, k);
-                          const auto [f, g] = piece[k];
-                          if (plan.box_test && !boxes_meet(f, g)) continue;
-                          ++out.c.triangle_pairs;
-                          features(f, g, out);
+                        for (std::size_t k0 = 0; k0 < piece.size(); k0 += kBatch) {
+                          chunk(pieces[p].first, piece, k0, std::min(piece.size(), k0 + kBatch),
+                                out);
                         }
                       }
                     });

@@ -247,9 +247,11 @@ struct SelfCore : MeshState {
   [[nodiscard]] LoopSide loop_side(const FeatureContext& ctx) const {
     return {ctx.v0, ctx.v1, &topo.faces(), ctx.face_boxes, ctx.fboxes};
   }
-  // The pair loop's prefetch of face f's ownership record and box block.
+  // The pair loop's prefetch of faces f's and g's ownership records and box blocks. Inlined
+  // always: a function of prefetches alone counts as free of side effects, and its calls would
+  // be dropped.
   [[nodiscard]] auto fetch(const FeatureContext& ctx) const {
-    return [this, &ctx](int f, int g) {
+    return [ this, &ctx ](int f, int g) __attribute__((always_inline)) {
       for (int h : {f, g}) {
         prefetch(&owner.record(h));
         const auto* block = reinterpret_cast<const char*>(&ctx.face_boxes[h]);
