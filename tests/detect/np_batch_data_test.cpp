@@ -14,6 +14,7 @@
 #include "clothcd/mesh/io.hpp"
 #include "detect/narrow.hpp"
 #include "support/data.hpp"
+#include "support/isa_paths.hpp"
 #include "support/json_file.hpp"
 
 namespace clothcd::np_batch_data_test {
@@ -75,7 +76,9 @@ void compare_verdicts(ccd_detail::Kind kind, const std::vector<std::pair<int, in
       b.push(points_of(pairs[i]));
     ASSERT_TRUE(ccd_detail::np_filter_batch_with(0, kind, b, expect.data()));
     for (int isa = 1; isa <= 3; ++isa) {
-      if (!ccd_detail::np_filter_batch_with(isa, kind, b, got.data())) continue;
+      const bool ran = ccd_detail::np_filter_batch_with(isa, kind, b, got.data());
+      test::note_isa("np_filter_batch", isa, ran);
+      if (!ran) continue;
       for (int i = 0; i < b.size; ++i)
         ASSERT_EQ(got[i], expect[i]) << "isa " << isa << " pair " << start + i;
     }
@@ -138,10 +141,10 @@ void compare_settled(ccd_detail::Kind kind, const std::vector<std::pair<int, int
     EXPECT_TRUE(ccd_detail::fast_path_settle_with(0, kind, b, verdict.data(), opt.toi_tolerance,
                                                   expect, expect_toi));
     for (int isa = 1; isa <= 3; ++isa) {
-      if (!ccd_detail::fast_path_settle_with(isa, kind, b, verdict.data(), opt.toi_tolerance, got,
-                                             got_toi)) {
-        continue;
-      }
+      const bool ran = ccd_detail::fast_path_settle_with(isa, kind, b, verdict.data(),
+                                                         opt.toi_tolerance, got, got_toi);
+      test::note_isa("fast_path_settle", isa, ran);
+      if (!ran) continue;
       for (int i = 0; i < b.size; ++i) {
         EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " pair " << start + i;
         if (got[i] == FastSettled::Hit && expect[i] == FastSettled::Hit) {
