@@ -39,13 +39,13 @@ STAGES = [
     ("reading the frames", 1, [r"clothcd::read_mesh\("]),
     ("building the detector (topology, tree, orphans, ownership)", 1,
      [r"clothcd::SelfDetector::SelfDetector\("]),
-    ("detection", 1, [r"clothcd::SelfDetector::Impl::detect\("]),
-    ("refit (boxes and cones)", 2, [r"clothcd::SelfDetector::Impl::refit\("]),
+    ("detection", 1, [r"clothcd::detail::SelfCore::detect\("]),
+    ("refit (boxes and cones)", 2, [r"clothcd::detail::SelfCore::refit\("]),
     ("traversal (box and cone tests, triangle pairs)", 2,
-     [r"clothcd::SelfDetector::Impl::traverse\("]),
-    ("narrow phase", 2, [r"clothcd::SelfDetector::Impl::narrow\("]),
+     [r"clothcd::detail::SelfCore::traverse\("]),
+    ("narrow phase", 2, [r"clothcd::detail::SelfCore::narrow\("]),
     ("whole-triangle distance filter (vectorised)", 3,
-     [r"clothcd::detail::triangles_filter_batch\("]),
+     [r"clothcd::ccd_detail::triangles_filter_batch\("]),
     ("NP filter (vectorised)", 3, [r"clothcd::ccd_detail::np_filter_batch\("]),
     ("feature distance filter (vectorised)", 3, [r"clothcd::ccd_detail::distance_filter_batch\("]),
     ("fast-path settle (vectorised)", 3, [r"clothcd::ccd_detail::fast_path_settle\("]),
@@ -102,6 +102,8 @@ def profile(binary, args, tmp):
     rows = []
     for label, depth, pats in STAGES:
         n = stage_count(counts, pats)
+        if n is None and label.startswith("scalar kernels"):
+            n = 0  # a step whose batches settle every pair calls no scalar kernel
         if n is None:
             sys.exit(f"detect_profile.py: no function of the profile matches the stage '{label}' "
                      f"({', '.join(pats)}): renamed, inlined, or a binary without symbols?")
