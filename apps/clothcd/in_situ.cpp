@@ -322,6 +322,17 @@ std::string report(const InSituArgs& a, const std::vector<SceneResult>& results,
 }  // namespace
 
 int run_in_situ(const InSituArgs& a) {
+  if (a.tables_only) {
+    if (a.out.empty()) throw InputError("--in-situ-tables: --out (the results folder) is required");
+    const fs::path folder =
+        fs::path(a.out).extension() == ".md" ? fs::path(a.out).parent_path() : fs::path(a.out);
+    if (!fs::exists(folder / "in_situ.csv")) {
+      throw InputError(fmt::format("--in-situ-tables: no in_situ.csv in '{}'", folder.string()));
+    }
+    for (const fs::path& t : experiment::update_in_situ_sections(folder))
+      fmt::print("rewrote the in-situ section of {}\n", t.string());
+    return 0;
+  }
   if (a.scenes.empty()) throw InputError("--in-situ: no scene files given");
   if (a.frames < 1) throw InputError("--frames: at least 1 frame");
   // SCENE@N: at most N frames of that scene.
@@ -383,6 +394,13 @@ int run_in_situ(const InSituArgs& a) {
     if (!md_path.parent_path().empty()) fs::create_directories(md_path.parent_path());
     write_file_atomic(csv_path, csv);
     write_file_atomic(md_path, report(a, results, header));
+  }
+  // The tables read in_situ.csv: only a report of that name is theirs.
+  if (md_path.filename() == "in_situ.md") {
+    for (const fs::path& t : experiment::update_in_situ_sections(
+             md_path.parent_path().empty() ? fs::path(".") : md_path.parent_path())) {
+      fmt::print("rewrote the in-situ section of {}\n", t.string());
+    }
   }
   fmt::print("results in {} and {}\n", md_path.string(), csv_path.string());
   return 0;

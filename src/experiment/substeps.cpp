@@ -3,9 +3,17 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <set>
 #include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
+#include "clothcd/core/atomic_file.hpp"
+#include "clothcd/experiment/experiment.hpp"
 #include "format.hpp"
 #include "records.hpp"
 
@@ -106,3 +114,35 @@ std::string in_situ_times_section(const Totals& totals) {
 }
 
 }  // namespace clothcd::experiment::detail
+
+namespace clothcd::experiment {
+
+std::vector<std::filesystem::path> update_in_situ_sections(const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> done;
+  const fs::path csv = folder / "in_situ.csv";
+  if (!fs::exists(csv)) return done;
+  const auto totals = detail::read_in_situ(csv);
+  constexpr std::string_view kTitle = "## Per simulation substep, inside the simulator";
+  for (const auto& [name, section] :
+       {std::pair{"table1.md", detail::in_situ_pairs_section(totals)},
+        std::pair{"table2.md", detail::in_situ_times_section(totals)}}) {
+    const fs::path table = folder / name;
+    if (!fs::exists(table)) continue;
+    std::ifstream in(table, std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // The section runs to the next heading of its level, or to the end.
+    const std::size_t at = text.find(kTitle);
+    if (at == std::string::npos) {
+      text += (text.empty() || text.back() == '\n' ? "\n" : "\n\n") + section;
+    } else {
+      const std::size_t next = text.find("\n## ", at + kTitle.size());
+      text.replace(at, next == std::string::npos ? std::string::npos : next + 1 - at, section);
+    }
+    write_file_atomic(table, text);
+    done.push_back(table);
+  }
+  return done;
+}
+
+}  // namespace clothcd::experiment
