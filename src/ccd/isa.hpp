@@ -17,12 +17,21 @@ inline bool has_avx512() {
 }
 #endif
 
+/// The body run_on(-1, ...) runs on this processor (0 scalar, 1 SSE2, 2 AVX2, 3 AVX-512F).
+inline int widest_isa() {
+#if CLOTHCD_NP_BATCH_X86
+  return has_avx512() ? 3 : (has_avx2() ? 2 : 1);
+#else
+  return 0;
+#endif
+}
+
 /// Runs body[isa] (0 scalar, 1 SSE2, 2 AVX2, 3 AVX-512F; -1: the widest the processor has) on
 /// `args`; false, running nothing, where the processor or the build lacks it (a null entry).
 template <class Fn, class... Args>
 bool run_on(int isa, const Fn (&body)[4], Args&&... args) {
 #if CLOTHCD_NP_BATCH_X86
-  if (isa < 0) isa = has_avx512() ? 3 : (has_avx2() ? 2 : 1);
+  if (isa < 0) isa = widest_isa();
   if ((isa == 2 && !has_avx2()) || (isa == 3 && !has_avx512())) return false;
 #else
   if (isa < 0) isa = 0;

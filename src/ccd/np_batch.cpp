@@ -136,6 +136,10 @@ bool distance_filter_batch_with(int isa, Kind kind, const NpBatch& b, double thi
   return isa >= 0 && run_on(isa, kDistance, kind, b, thickness, depth, verdict);
 }
 
+int batch_isa() {
+  return widest_isa();
+}
+
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict) {
   return isa >= 0 && run_on(isa, kNp, kind, b, verdict);
 }

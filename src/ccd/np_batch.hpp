@@ -39,6 +39,10 @@ void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict);
 /// lacks it.
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict);
 
+/// The instruction set the batches (these and face_batch.hpp's) run on this processor, in the
+/// ids of the *_with functions: the widest it has.
+int batch_isa();
+
 /// The distance filter on the queries the NP filter kept: verdict[i] becomes Culled where
 /// distance_filter_culls(query i, thickness, depth) holds, for each i < b.size whose verdict is
 /// Kept (such queries are finite). Uses the widest vector instructions the processor has; each lane

@@ -41,12 +41,10 @@ void check_same_build(BvhBuild built, BvhBuild asked, std::string_view call) {
 }
 
 SelfCore::SelfCore(std::vector<Face> faces, int nv, PointsIn ref, const DetectOptions& o)
-    : topo(std::move(faces), nv), opt(o) {
-  check_self_options(o);
+    : MeshState((check_self_options(o), std::move(faces)), nv, ref, "reference shape", o.build,
+                true, true),
+      opt(o) {
   cull = o.culling == Culling::Sound ? Rule::Sound : Rule::None;
-  std::vector<Eigen::Vector3d> reference;
-  to_points(ref, nv, "reference shape", reference);
-  bvh = Bvh(topo, reference, o.build);
   orphans = find_orphans(topo);
   owner = Ownership(topo);
 }
@@ -83,22 +81,22 @@ void SelfCore::refit(DetectStats& st) {
   st.disk_internal_nodes = bvh.num_disk_internal();
 }
 
-DetectResult SelfCore::detect(PointsIn p0, PointsIn p1) {
+DetectResult SelfCore::detect(PointsIn p0, PointsIn p1, bool kernels) {
   step.update(p0, p1, topo.num_vertices(), "positions at t0", "positions at t1");
   update_links();
   DetectResult res;
   DetectStats& st = res.stats;
   refit(st);
   auto t = Clock::now();
-  const PairList pairs = traverse(rule(), st, pair_locals, opt.reuse_front && !restricted);
+  const PairList pairs = traverse(rule(), scope(), st, pair_locals, opt.reuse_front && !restricted);
   st.time_traverse = seconds_since(t);
   t = Clock::now();
   FeatureContext ctx = ccd_context();
-  ctx.filters_only = window_filters_only;
+  ctx.plan.kernel = kernels;
   boxes.update(ctx, step);
   const bool keep = keeps() && !restricted;
   std::vector<std::uint8_t> near;
-  narrow(ctx, pairs, res, keep ? &near : nullptr);
+  narrow(ctx, pairs, scope(), res, keep ? &near : nullptr);
   st.time_narrow = seconds_since(t);
   if (keep) {
     reuse.x1 = v1;
@@ -111,60 +109,13 @@ DetectResult SelfCore::detect(PointsIn p0, PointsIn p1) {
   return res;
 }
 
-void SelfCore::set_active(std::span<const int> active_faces) {
-  const int nf = topo.num_faces();
-  face_active.assign(nf, 0);
-  vertex_active.assign(topo.num_vertices(), 0);
-  edge_active.assign(topo.num_edges(), 0);
-  for (int f : active_faces) {
-    if (f < 0 || f >= nf) {
-      throw InputError(fmt::format("active face {} is out of range [0, {})", f, nf));
-    }
-    face_active[f] = 1;
-    for (int v : topo.faces()[f])
-      vertex_active[v] = 1;
-    for (int e : topo.face_edges(f))
-      edge_active[e] = 1;
-  }
-  // A face touching an active vertex can be the representative of an in-scope pair.
-  std::vector<std::uint8_t> touch(nf, 0);
-  for (int f = 0; f < nf; ++f) {
-    for (int v : topo.faces()[f])
-      touch[f] |= vertex_active[v];
-  }
-  set_nodes(touch);
-}
-
-void SelfCore::set_active_vertices(std::span<const int> active_vertices) {
-  const int nv = topo.num_vertices();
-  vertex_active.assign(nv, 0);
-  for (int v : active_vertices) {
-    if (v < 0 || v >= nv) {
-      throw InputError(fmt::format("active vertex {} is out of range [0, {})", v, nv));
-    }
-    vertex_active[v] = 1;
-  }
-  face_active = topo.faces_touching(vertex_active);
-  edge_active = topo.edges_touching(vertex_active);
-  set_nodes(face_active);
-}
-
-void SelfCore::set_nodes(const std::vector<std::uint8_t>& touch) {
-  node_active = bvh.nodes_holding(touch);
-  restricted = true;
-}
-
 }  // namespace detail
 
 namespace {
 // SelfDetector::rebuild for either input form.
 void rebuild_detector(detail::SelfCore& im, detail::PointsIn reference) {
-  std::vector<Eigen::Vector3d> ref;
-  detail::to_points(reference, im.topo.num_vertices(), "reference shape", ref);
-  im.bvh = Bvh(im.topo, ref, im.opt.build);
-  im.bvh_call = 0;
-  im.restricted = false;  // its node flags belonged to the old tree
-  im.front.clear();       // and so did the front's node pairs
+  im.rebuild(reference, "reference shape", im.opt.build, true);
+  im.front.clear();  // the front's node pairs belonged to the old tree
 }
 }  // namespace
 
@@ -207,13 +158,13 @@ EarliestImpact SelfDetector::earliest_impact(std::span<const Eigen::Vector3d> v_
   return impl_->earliest_impact(v_t0, v_t1, options);
 }
 void SelfDetector::set_active_faces(std::span<const int> faces) {
-  impl_->set_active(faces);
+  impl_->set_active_faces(faces);
 }
 void SelfDetector::set_active_vertices(std::span<const int> vertices) {
-  impl_->set_active_vertices(vertices);
+  impl_->set_active_vertices(vertices, "");
 }
 void SelfDetector::clear_active() {
-  impl_->restricted = false;
+  impl_->clear_active();
 }
 void SelfDetector::rebuild(const Positions& reference) {
   rebuild_detector(*impl_, reference);

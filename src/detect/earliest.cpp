@@ -108,7 +108,6 @@ EarliestImpact SelfCore::earliest_impact(PointsIn p0, PointsIn p1, const Earlies
     ~Restore() {
       core.opt = saved;
       core.cull = rule;
-      core.window_filters_only = false;
     }
   } restore{*this, saved, saved_rule};
   return search_windows(
@@ -118,10 +117,9 @@ EarliestImpact SelfCore::earliest_impact(PointsIn p0, PointsIn p1, const Earlies
         // little, so its traversal tests boxes only. Its filters pick its hits, which the step's
         // kernels time; the step's own hits come with their coarse times.
         cull = t < 1 ? Rule::None : saved_rule;
-        window_filters_only = t < 1;
         if (t < 1) interpolate(x0, x1, t, xt);
         const DetectResult r = detect(std::span<const Eigen::Vector3d>(x0),
-                                      std::span<const Eigen::Vector3d>(t < 1 ? xt : x1));
+                                      std::span<const Eigen::Vector3d>(t < 1 ? xt : x1), t == 1);
         add_stats(r.stats, stats);
         search.add(r.vf, r.ee, t, false);
       });

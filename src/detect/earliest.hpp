@@ -1,7 +1,7 @@
 #pragma once
 // The earliest-impact query of both detectors, as detections over time windows. A window [0, T]
 // is the sub-step x0 -> x(T) = x0 + T (x1 - x0), run through the detector's own pipeline (boxes,
-// traversal, filters; FeatureContext::filters_only) at the thickness plus an allowance for the
+// traversal, filters; FilterPlan::kernel) at the thickness plus an allowance for the
 // rounding of x(T): its boxes and filters see only the motion up to T, so a short window holds
 // few candidate pairs and filters away almost all of them. Its hits, the pairs the filters keep,
 // may touch by T; the step's own kernels time them (over the whole step, as detect() would), and

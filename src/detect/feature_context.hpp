@@ -6,14 +6,69 @@
 
 namespace clothcd::detail {
 
+/// A filter that feature queries go through before the kernel, in this order of its steps.
+enum class FeatureFilter : std::uint8_t {
+  None,        // the kernel decides alone
+  Np,          // the cubic NP filter (zero thickness)
+  NpDistance,  // the NP filter, then the distance filter on what it keeps (zero thickness)
+  Distance,    // the distance filter at the thickness
+};
+
+/// The filter pipeline of one pass, resolved once from the options (filter_plan): what the
+/// triangle pairs and the feature pairs go through before the kernels. The pair loop and the
+/// batches switch on it; a query tested alone (ccd_hit) runs `single`, a batch `batch`, with the
+/// same verdicts, counts and times of impact.
+struct FilterPlan {
+  bool faces_apart = false;  // triangle pairs through the whole-triangle distance bound first
+  FeatureFilter single = FeatureFilter::None;  // a query alone, before its kernel
+  // A batch of queries; at zero thickness with the fast path, the NP filter that the kernel
+  // would start with (its culls counted only where np_filter is on).
+  FeatureFilter batch = FeatureFilter::None;
+  bool settle = false;     // the batch settles queries with the zero-thickness kernel's search
+  bool count_np = false;   // filter culls count as NP culls (DetectOptions::np_filter)
+  bool kernel = true;      // false: every pair the filters keep is a hit at time 0
+  int distance_depth = 0;  // bisections of the distance filter at a thickness
+
+  friend bool operator==(const FilterPlan&, const FilterPlan&) = default;
+};
+
+/// Bisections of the distance filter at zero thickness: on cloth_ball 92 -> 93 it culls 44% of
+/// the pairs the NP filter keeps at depth 0, 80% at depth 2, each a search the fast path is
+/// spared; deeper costs more than its further culls save.
+inline constexpr int kZeroThicknessDepth = 2;
+
+/// The pipeline of DetectOptions' thickness, np_filter, distance_filter (and its depth) and
+/// fast_path. With a thickness the cubic NP filter does not apply: the distance bound takes its
+/// place (it culls resting contact, the bulk of a simulator's pairs). At zero thickness the
+/// distance filter runs on what the NP filter keeps, with distance_filter.
+[[nodiscard]] inline FilterPlan filter_plan(double thickness, bool np_filter, bool distance_filter,
+                                            bool fast_path, int distance_depth) {
+  FilterPlan p;
+  p.faces_apart = np_filter && (thickness > 0 || distance_filter);
+  p.count_np = np_filter;
+  p.distance_depth = distance_depth;
+  if (thickness > 0) {
+    p.single = p.batch = np_filter ? FeatureFilter::Distance : FeatureFilter::None;
+    return p;
+  }
+  const FeatureFilter np =
+      np_filter && distance_filter ? FeatureFilter::NpDistance : FeatureFilter::Np;
+  // With the fast path the kernel starts with the same NP filter (one cubic, computed once), so
+  // a query alone runs the separate one only where the distance filter follows it.
+  p.single = !np_filter                             ? FeatureFilter::None
+             : fast_path && np == FeatureFilter::Np ? FeatureFilter::None
+                                                    : np;
+  p.batch = np_filter || fast_path ? np : FeatureFilter::None;
+  p.settle = fast_path;
+  return p;
+}
+
 /// Positions of one step and the test settings.
 struct FeatureContext {
   const Topology* topo = nullptr;
   std::span<const Eigen::Vector3d> v0, v1;
   double margin = 0;  // thickness / 2
-  bool np_filter = true;
-  bool zero_thickness_distance = false;  // DetectOptions::distance_filter
-  int distance_depth = 0;                // DetectOptions::distance_filter_depth
+  FilterPlan plan;
   CcdOptions ccd;
   /// Optional swept boxes of every vertex, edge and face for this step (`precompute_boxes`);
   /// empty: computed on demand.
@@ -23,9 +78,6 @@ struct FeatureContext {
   std::span<const FaceBoxes> face_boxes;
   /// DetectOptions::linked_vertices as (smaller, larger), sorted and unique (`sorted_links`).
   std::span<const std::pair<int, int>> links;
-  /// Every pair the filters keep counts as a hit at time 0, without a kernel: the earliest-impact
-  /// query's windows, whose hits the step's own kernels time (earliest.hpp).
-  bool filters_only = false;
 
   [[nodiscard]] bool grouped(int u, int v) const {
     if (links.empty()) return false;
@@ -88,8 +140,8 @@ struct FeatureContext {
   }
 
   /// kernel_vf deferred to a batch: the pairs the batched filters cull are counted as kernel_vf
-  /// counts them, the others go through kernel_vf's path (all of them without a vectorised
-  /// filter in the settings, batched()). `flush` tests what is left.
+  /// counts them, the others go through kernel_vf's path (all of them where the plan has no
+  /// batch filter). `flush` tests what is left.
   void queue_vf(int v, int f, FeatureBatch& b, FeatureCounters& c,
                 std::vector<VertexFaceCollision>& out) const {
     queue_vf(v, f, topo->faces()[f], b, c, out);
@@ -133,23 +185,21 @@ struct FeatureContext {
 
   /// Tests the queries queued in `q` (b.vf or b.ee, of kind `kind`; b's other arrays serve as
   /// scratch) as ccd_hit tests them, and empties it: the batch filters, then the kernel on what
-  /// they keep (without a vectorised filter in the settings, batched(), ccd_hit's own path one
-  /// query at a time). Counts each query in `tests` and a filter's cull in `culled`; calls
-  /// hit(i, toi) for each query i that collides. The same verdicts, counts and times of impact
-  /// as ccd_hit one query at a time.
+  /// they keep (without a batch filter in the plan, ccd_hit's own path one query at a time). Counts
+  /// each query in `tests` and a filter's cull in `culled`; calls hit(i, toi) for each query i that
+  /// collides. The same verdicts, counts and times of impact as ccd_hit one query at a time.
   template <class Hit>
   void flush_queries(ccd_detail::Kind kind, ccd_detail::NpBatch& q, FeatureBatch& b,
                      std::uint64_t& tests, std::uint64_t& culled, Hit&& hit) const {
     if (q.size == 0) return;
     filter_batch(kind, q, b);
-    const bool settle = settles();
     for (int i = 0; i < q.size; ++i) {
       ++tests;
       if (b.verdict[i] == ccd_detail::NpVerdict::Culled) {
-        culled += np_filter ? 1 : 0;
+        culled += plan.count_np ? 1 : 0;
         continue;
       }
-      if (settle && b.settled[i] != ccd_detail::FastSettled::Run) {  // the kernel's own answer
+      if (plan.settle && b.settled[i] != ccd_detail::FastSettled::Run) {  // the kernel's own answer
         if (b.settled[i] == ccd_detail::FastSettled::Hit) hit(i, b.toi[i]);
         continue;
       }
@@ -172,84 +222,65 @@ struct FeatureContext {
     return ccd_test(q, culled, toi);
   }
 
-  /// Whether the distance filter is the one in use (thickness > 0, filters on).
-  [[nodiscard]] bool distance_at_thickness() const { return np_filter && ccd.thickness > 0; }
-  /// Whether triangle pairs go through the whole-triangle distance bound first: with the distance
-  /// filter, or at zero thickness with DetectOptions::distance_filter.
-  [[nodiscard]] bool faces_apart_filter() const {
-    return np_filter && (ccd.thickness > 0 || zero_thickness_distance);
-  }
-
-  /// Whether the distance filter runs at zero thickness too (DetectOptions::distance_filter, with
-  /// np_filter) on feature pairs: on the pairs the NP filter keeps, at depth kZeroThicknessDepth.
-  [[nodiscard]] bool distance_at_zero() const {
-    return np_filter && zero_thickness_distance && ccd.thickness == 0;
-  }
-  /// Bisections of that filter: on cloth_ball 92 -> 93 it culls 44% of the pairs the NP filter
-  /// keeps at depth 0, 80% at depth 2, each a search the fast path is spared; deeper costs more
-  /// than its further culls save.
-  static constexpr int kZeroThicknessDepth = 2;
-
-  /// Whether a query's first test is the cubic NP filter (unscaled_np_filter), whose culls the
-  /// batched filter may decide: at zero thickness, as the separate filter or as the fast path's
-  /// first step.
-  [[nodiscard]] bool batched_np() const {
-    return ccd.thickness == 0 && (np_filter || ccd.fast_path);
-  }
-  /// Whether queue_vf / queue_ee defer pairs to a batch: where a query's first test has a
-  /// vectorised form, the cubic NP filter at zero thickness (batched_np) or the distance filter
-  /// at a thickness (distance_at_thickness). In a simulator's contact stage (a thickness, pairs
-  /// mostly resting at about that distance) the distance filter culls nearly all of them.
-  [[nodiscard]] bool batched() const { return batched_np() || distance_at_thickness(); }
-
  private:
   // ccd_hit without counting the test. `kept`: the batch's filters have kept q already (at zero
   // thickness unscaled_np_filter's verdict is Kept, then np_filter_culls is false and the kernel
   // need not run that filter again; at a thickness the distance filter has not culled it).
   template <class Query>
   bool ccd_test(const Query& q, std::uint64_t& culled, double& toi, bool kept = false) const {
-    // At zero thickness the distance filter tests what the NP filter keeps, as in the batches.
-    if (!kept &&
-        ((separate_np() && np_filter_culls(q)) ||
-         (distance_at_thickness() && distance_filter_culls(q, ccd.thickness, distance_depth)) ||
-         (distance_at_zero() && !np_filter_culls(q) &&
-          distance_filter_culls(q, 0.0, kZeroThicknessDepth)))) {
+    if (!kept && single_filter_culls(q)) {
       ++culled;
       return false;
     }
-    if (filters_only) {
+    if (!plan.kernel) {
       toi = 0;
       return true;
     }
     const CcdResult r =
         kept && ccd.thickness == 0 ? ccd_kernel_np_kept(q, ccd) : ccd_kernel(q, ccd);
-    culled += counted_np(r);
+    culled += plan.count_np && r.path == CcdPath::NpCulled ? 1 : 0;
     if (r.hit) toi = r.toi;
     return r.hit;
   }
 
-  // Whether the batches settle queries with the zero-thickness kernel's own search.
-  [[nodiscard]] bool settles() const { return ccd.fast_path && ccd.thickness == 0; }
+  // The plan's filter for a query alone (plan.single).
+  template <class Query>
+  [[nodiscard]] bool single_filter_culls(const Query& q) const {
+    switch (plan.single) {
+      case FeatureFilter::None:
+        return false;
+      case FeatureFilter::Np:
+        return np_filter_culls(q);
+      case FeatureFilter::NpDistance:
+        return np_filter_culls(q) || distance_filter_culls(q, 0.0, kZeroThicknessDepth);
+      case FeatureFilter::Distance:
+        return distance_filter_culls(q, ccd.thickness, plan.distance_depth);
+    }
+    return false;
+  }
 
-  // The batch's filters in ccd_test's order. Without a vectorised filter none (every verdict
-  // Undecided: ccd_test decides). At a thickness the distance filter alone (every query starts
-  // Kept). At zero thickness the NP filter, the distance filter on what it keeps
-  // (distance_at_zero), and with the fast path the kernel's own search down to kSettleLevel.
+  // The batch's filters (plan.batch), then with plan.settle the kernel's own search down to
+  // kSettleLevel. Without a batch filter every verdict is Undecided (ccd_test decides); at a
+  // thickness every query starts Kept.
   void filter_batch(ccd_detail::Kind kind, const ccd_detail::NpBatch& q, FeatureBatch& b) const {
-    if (!batched()) {
-      std::fill_n(b.verdict.begin(), q.size, ccd_detail::NpVerdict::Undecided);
-      return;
+    switch (plan.batch) {
+      case FeatureFilter::None:
+        std::fill_n(b.verdict.begin(), q.size, ccd_detail::NpVerdict::Undecided);
+        return;
+      case FeatureFilter::Distance:
+        std::fill_n(b.verdict.begin(), q.size, ccd_detail::NpVerdict::Kept);
+        ccd_detail::distance_filter_batch(kind, q, ccd.thickness, plan.distance_depth,
+                                          b.verdict.data());
+        return;
+      case FeatureFilter::Np:
+      case FeatureFilter::NpDistance:
+        ccd_detail::np_filter_batch(kind, q, b.verdict.data());
+        if (plan.batch == FeatureFilter::NpDistance) {
+          ccd_detail::distance_filter_batch(kind, q, 0.0, kZeroThicknessDepth, b.verdict.data());
+        }
+        break;
     }
-    if (distance_at_thickness()) {
-      std::fill_n(b.verdict.begin(), q.size, ccd_detail::NpVerdict::Kept);
-      ccd_detail::distance_filter_batch(kind, q, ccd.thickness, distance_depth, b.verdict.data());
-      return;
-    }
-    ccd_detail::np_filter_batch(kind, q, b.verdict.data());
-    if (distance_at_zero()) {
-      ccd_detail::distance_filter_batch(kind, q, 0.0, kZeroThicknessDepth, b.verdict.data());
-    }
-    if (settles()) {
+    if (plan.settle) {
       ccd_detail::fast_path_settle(kind, q, b.verdict.data(), ccd.toi_tolerance, b.settled.data(),
                                    b.toi.data());
     }
@@ -275,13 +306,6 @@ struct FeatureContext {
     });
   }
 
-  // With the fast path on, the kernel starts with the same NP filter (one cubic, computed once);
-  // without it the filter runs on its own first.
-  [[nodiscard]] bool separate_np() const {
-    return np_filter && ccd.thickness == 0 && !ccd.fast_path;
-  }
-  // With a thickness the cubic filter does not apply; the distance bound takes its place (it
-  // culls resting contact, the bulk of a simulator's pairs): see distance_at_thickness().
   static CcdResult ccd_kernel(const VertexFaceQuery& q, const CcdOptions& o) {
     return vertex_face_ccd(q, o);
   }
@@ -293,9 +317,6 @@ struct FeatureContext {
   }
   static CcdResult ccd_kernel_np_kept(const EdgeEdgeQuery& q, const CcdOptions& o) {
     return ccd_detail::edge_edge_ccd_np_kept(q, o);
-  }
-  [[nodiscard]] bool counted_np(const CcdResult& r) const {
-    return np_filter && r.path == CcdPath::NpCulled;
   }
 };
 
@@ -328,11 +349,10 @@ inline FeatureContext ccd_context(const Topology& topo, std::span<const Eigen::V
   ctx.v0 = v0;
   ctx.v1 = v1;
   ctx.margin = 0.5 * options.thickness;
-  ctx.np_filter = options.np_filter;
-  ctx.zero_thickness_distance = options.distance_filter;
+  ctx.plan = filter_plan(options.thickness, options.np_filter, options.distance_filter,
+                         options.fast_path, options.distance_filter_depth);
   ctx.ccd = CcdOptions{options.thickness, options.fast_path};
   ctx.ccd.toi_tolerance = options.toi_tolerance;
-  ctx.distance_depth = options.distance_filter_depth;
   ctx.links = links;
   return ctx;
 }

@@ -17,8 +17,10 @@
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/detect/names.hpp"
 #include "earliest.hpp"
+#include "mesh_state.hpp"
 #include "narrow.hpp"
 #include "options.hpp"
+#include "pair_loop.hpp"
 #include "pair_results.hpp"
 #include "positions.hpp"
 
@@ -49,50 +51,6 @@ void check_pair_options(const DetectOptions& o) {
   detail::check_common_options(o);
 }
 
-// One mesh: its topology, tree, swept boxes, positions of the current call, active restriction.
-struct Side {
-  Topology topo;
-  Bvh bvh;
-  detail::FeatureBoxes boxes;
-  // The positions of the current call and which vertices changed since the one before.
-  detail::StepPositions step;
-  const std::vector<Eigen::Vector3d>& x0 = step.x0();
-  const std::vector<Eigen::Vector3d>& x1 = step.x1();
-  std::uint64_t bvh_call = 0;  // the call of `step` the tree was last swept at (0: none)
-  // Active vertices, the edges and faces touching one, and the nodes holding such a face.
-  std::vector<std::uint8_t> vertex_active, edge_active, face_active, node_active;
-
-  Side(std::vector<Face> faces, int nv, detail::PointsIn ref, std::string_view name, BvhBuild build)
-      : topo(std::move(faces), nv) {
-    std::vector<Eigen::Vector3d> reference;
-    detail::to_points(ref, nv, name, reference);
-    bvh = Bvh::boxes_only(topo, reference, build);  // no cones: they cannot cull between meshes
-  }
-  Side(const Side&) = delete;  // x0 and x1 refer into `step`
-  Side& operator=(const Side&) = delete;
-
-  // The swept boxes of a CCD call (the tree redoes only what changed since its last one).
-  void sweep(const RefitOptions& options) {
-    bvh.refit_moved(x0, x1, options, step.changed_since(bvh_call));
-    bvh_call = step.call();
-  }
-
-  void set_active(std::span<const int> vertices, std::string_view mesh) {
-    const int nv = topo.num_vertices();
-    vertex_active.assign(nv, 0);
-    for (int v : vertices) {
-      if (v < 0 || v >= nv) {
-        throw InputError(
-            fmt::format("active vertex {} of mesh {} is out of range [0, {})", v, mesh, nv));
-      }
-      vertex_active[v] = 1;
-    }
-    face_active = topo.faces_touching(vertex_active);
-    edge_active = topo.edges_touching(vertex_active);
-    node_active = bvh.nodes_holding(face_active);
-  }
-};
-
 // The feature pairs of one leaf pair (fa, fb) that it represents (their features' first faces
 // are fa and fb) and that the scope keeps, past the feature box test: vf(v, f) with a vertex of
 // A and a face of B, fv(u, f) with a vertex of B and a face of A, ee(a, b).
@@ -122,15 +80,21 @@ void face_pair(const detail::FeatureContext& ca, const detail::FeatureContext& c
   }
 }
 
-struct Buffer {
-  detail::FeatureCounters c;
-  detail::FacesApartBatch faces;  // triangle pairs, distance-filtered a batch at a time
+struct Buffer : detail::LoopBuffers {
   // Feature pairs waiting for the batch filters: A's vertices against B's faces and the edge
   // pairs in `queued`, B's vertices against A's faces in `queued_ba` (its vf part).
   detail::FeatureBatch queued, queued_ba;
   std::vector<VertexFaceCollision> ab, ba;
   std::vector<EdgeEdgeCollision> ee;
 };
+
+// The pair loop's side of mesh m under context c (no face blocks: the feature tests read the
+// plain boxes).
+detail::LoopSide loop_side(const detail::MeshState& m, const detail::FeatureContext& c) {
+  return {m.v0, m.v1, &m.topo.faces(), {}, c.fboxes};
+}
+// The two-mesh loop reads its boxes in the order of its pairs: nothing to fetch ahead.
+constexpr auto no_fetch = [](int, int) {};
 
 template <class Item>
 void sort_by_ids(std::vector<Item>& v) {
@@ -147,29 +111,28 @@ void sort_by_ids(std::vector<Item>& v) {
 
 struct PairDetector::Impl {
   DetectOptions opt;
-  Side a, b;
-  bool restricted = false;
-  // Set by earliest_impact() for its windows only (FeatureContext::filters_only).
-  bool window_filters_only = false;
+  detail::MeshState a, b;  // no cones: they cannot cull between meshes
+  // The active restriction, set on both meshes at once.
+  [[nodiscard]] bool restricted() const { return a.restricted; }
 
   Impl(std::vector<Face> fa, int na, detail::PointsIn ra, std::vector<Face> fb, int nb,
        detail::PointsIn rb, const DetectOptions& o)
       : opt((check_pair_options(o), o)),
-        a(std::move(fa), na, ra, "reference shape A", o.build),
-        b(std::move(fb), nb, rb, "reference shape B", o.build) {}
+        a(std::move(fa), na, ra, "reference shape A", o.build, false, false),
+        b(std::move(fb), nb, rb, "reference shape B", o.build, false, false) {}
 
   // The active restriction: a VF pair when its vertex or a vertex of its face is active, an EE
   // pair when an endpoint is active (SelfDetector::set_active_vertices across two meshes).
   struct Scope {
     const Impl& m;
     [[nodiscard]] bool vf(int v, int f) const {
-      return !m.restricted || m.a.vertex_active[v] != 0 || m.b.face_active[f] != 0;
+      return !m.restricted() || m.a.vertex_active[v] != 0 || m.b.face_active[f] != 0;
     }
     [[nodiscard]] bool fv(int u, int f) const {
-      return !m.restricted || m.b.vertex_active[u] != 0 || m.a.face_active[f] != 0;
+      return !m.restricted() || m.b.vertex_active[u] != 0 || m.a.face_active[f] != 0;
     }
     [[nodiscard]] bool ee(int ea, int eb) const {
-      return !m.restricted || m.a.edge_active[ea] != 0 || m.b.edge_active[eb] != 0;
+      return !m.restricted() || m.a.edge_active[ea] != 0 || m.b.edge_active[eb] != 0;
     }
   };
 
@@ -179,16 +142,14 @@ struct PairDetector::Impl {
     std::vector<std::pair<int, int>> v;
   };
   tbb::enumerable_thread_specific<Pairs> pair_locals;
-  std::vector<std::pair<int, int>> pairs_found;
   // Where the last unrestricted detect() with opt.reuse_front stopped (front.hpp).
   detail::TraversalFront front;
 
   // Overlapping leaf pairs (face of A, face of B), below active nodes when restricted; valid
   // until the next call. `from_front`: start from the front (unrestricted calls only), and keep
   // the new one.
-  const std::vector<std::pair<int, int>>& traverse(DetectStats& st, bool from_front = false) {
-    std::vector<std::pair<int, int>>& pairs = pairs_found;
-    pairs.clear();
+  detail::PairList traverse(DetectStats& st, bool from_front = false) {
+    detail::PairList pairs;
     const auto& na = a.bvh.nodes();
     const auto& nb = b.bvh.nodes();
     if (na.empty() || nb.empty()) return pairs;
@@ -208,23 +169,20 @@ struct PairDetector::Impl {
           a.bvh, b.bvh, [](int) { return true; }, leaf, pair_locals);
       st.front_pairs = front.size();
     } else {
-      std::span<const std::uint8_t> act_a, act_b;
-      if (restricted) {
-        act_a = a.node_active;
-        act_b = b.node_active;
-      }
       auto tr = detail::make_traversal(
-          std::span<const BvhNode>(na), std::span<const BvhNode>(nb), act_a, act_b,
-          [](int, detail::TraversalCounters&) { return false; }, leaf);
+          std::span<const BvhNode>(na), std::span<const BvhNode>(nb), a.active_nodes(),
+          b.active_nodes(), [](int, detail::TraversalCounters&) { return false; }, leaf);
       st.box_tests = detail::run_parallel(tr, {0, 0, false}, pair_locals).box_tests;
     }
     for (const auto& l : pair_locals)
-      pairs.insert(pairs.end(), l.v.begin(), l.v.end());
+      pairs.add(l.v);
     return pairs;
   }
 
+  // `kernels` false: every pair the filters keep is a hit at time 0 (the earliest-impact
+  // query's windows).
   PairDetectResult detect(detail::PointsIn a_t0, detail::PointsIn a_t1, detail::PointsIn b_t0,
-                          detail::PointsIn b_t1) {
+                          detail::PointsIn b_t1, bool kernels = true) {
     a.step.update(a_t0, a_t1, a.topo.num_vertices(), "mesh A at t0", "mesh A at t1");
     b.step.update(b_t0, b_t1, b.topo.num_vertices(), "mesh B at t0", "mesh B at t1");
     auto t = Clock::now();
@@ -237,18 +195,18 @@ struct PairDetector::Impl {
 
     t = Clock::now();
     DetectStats st;
-    const auto& pairs = traverse(st, opt.reuse_front && !restricted);
+    const detail::PairList pairs = traverse(st, opt.reuse_front && !restricted());
     const double t_trav = seconds_since(t);
 
     t = Clock::now();
-    detail::FeatureContext ca = detail::ccd_context(a.topo, a.x0, a.x1, opt);
-    ca.filters_only = window_filters_only;
-    detail::FeatureContext cb = detail::ccd_context(b.topo, b.x0, b.x1, opt);
+    detail::FeatureContext ca = detail::ccd_context(a.topo, a.v0, a.v1, opt);
+    ca.plan.kernel = kernels;
+    detail::FeatureContext cb = detail::ccd_context(b.topo, b.v0, b.v1, opt);
     a.boxes.update(ca, a.step);
     b.boxes.update(cb, b.step);
     tbb::enumerable_thread_specific<Buffer> locals;
     const Scope scope{*this};
-    const bool batched = ca.faces_apart_filter();
+    const bool batched = ca.plan.faces_apart;
     // Both contexts have the same settings; ca's filters and kernels test every feature pair.
     const auto& faces_a = a.topo.faces();
     const auto& faces_b = b.topo.faces();
@@ -272,43 +230,26 @@ struct PairDetector::Impl {
                          out.ee.push_back({ea, eb, edges_a[ea], edges_b[eb], toi});
                        });
     };
-    constexpr std::size_t kBatch = detail::FacesApartBatch::kCapacity;
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, pairs.size(), kBatch),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          Buffer& out = locals.local();
-          detail::FacesApartBatch& apart = out.faces;
-          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const auto [fa, fb] = pairs[i];
-            // The distance filter on whole triangles first, a batch of pairs at a time: where it
-            // culls, it culls each of their feature pairs.
-            const std::size_t k = (i - r.begin()) % kBatch;
-            if (batched && k == 0) {
-              const std::size_t end = std::min(r.end(), i + kBatch);
-              for (std::size_t j = i; j != end; ++j) {
-                const auto [x, y] = pairs[j];
-                apart.push(a.x0, a.x1, a.topo.faces()[x], b.x0, b.x1, b.topo.faces()[y]);
-              }
-              apart.run(opt.thickness);
-            }
-            if (batched && apart.apart[k]) {
-              ++out.c.faces_apart;
-              continue;
-            }
-            face_pair(
-                ca, cb, fa, fb, scope,
-                [&](int v, int f) {
-                  if (out.queued.push_vf({v, f}, ca.vf_points(v, cb, faces_b[f]))) flush_ab(out);
-                },
-                [&](int u, int f) {
-                  if (out.queued_ba.push_vf({u, f}, cb.vf_points(u, ca, faces_a[f]))) flush_ba(out);
-                },
-                [&](int ea, int eb) {
-                  if (out.queued.push_ee({ea, eb}, ca.ee_points(edges_a[ea], cb, edges_b[eb])))
-                    flush_ee(out);
-                });
-          }
-        });
+    detail::LoopPlan plan;
+    plan.filter = batched ? detail::TriangleFilter::Swept : detail::TriangleFilter::None;
+    plan.distance = opt.thickness;
+    pair_loop(pairs, loop_side(a, ca), loop_side(b, cb), plan, locals, no_fetch,
+              [&](int fa, int fb, Buffer& out) {
+                face_pair(
+                    ca, cb, fa, fb, scope,
+                    [&](int v, int f) {
+                      if (out.queued.push_vf({v, f}, ca.vf_points(v, cb, faces_b[f])))
+                        flush_ab(out);
+                    },
+                    [&](int u, int f) {
+                      if (out.queued_ba.push_vf({u, f}, cb.vf_points(u, ca, faces_a[f])))
+                        flush_ba(out);
+                    },
+                    [&](int ea, int eb) {
+                      if (out.queued.push_ee({ea, eb}, ca.ee_points(edges_a[ea], cb, edges_b[eb])))
+                        flush_ee(out);
+                    });
+              });
     for (auto& out : locals) {  // at most one partial batch of each kind per thread
       flush_ab(out);
       flush_ba(out);
@@ -363,21 +304,17 @@ struct PairDetector::Impl {
     struct Restore {
       Impl& m;
       const DetectOptions& saved;
-      ~Restore() {
-        m.opt = saved;
-        m.window_filters_only = false;
-      }
+      ~Restore() { m.opt = saved; }
     } restore{*this, saved};
     return detail::search_windows(
         first, slack, search, [&](double t, double sl, DetectStats& stats) {
           opt = detail::window_options(saved, sl, search.kernel().toi_tolerance);
-          window_filters_only = t < 1;
           if (t < 1) {
             detail::interpolate(x[0], x[1], t, at);
             detail::interpolate(x[2], x[3], t, bt);
           }
           const PairDetectResult r = detect(Points(x[0]), Points(t < 1 ? at : x[1]), Points(x[2]),
-                                            Points(t < 1 ? bt : x[3]));
+                                            Points(t < 1 ? bt : x[3]), t == 1);
           detail::add_stats(r.stats, stats);
           search.add(r.vf_a_on_b, r.ee, t, false);
           search.add(r.vf_b_on_a, {}, t, true);
@@ -390,71 +327,53 @@ struct PairDetector::Impl {
     }
     a.step.update_static(pa, a.topo.num_vertices(), "mesh A positions");
     b.step.update_static(pb, b.topo.num_vertices(), "mesh B positions");
-    RefitOptions ro;
-    ro.thickness = h;
-    ro.cones = false;
-    a.bvh.refit(a.x0, ro);
-    b.bvh.refit(b.x0, ro);
-    a.bvh_call = b.bvh_call = 0;
+    a.refit_static(h);
+    b.refit_static(h);
     DetectStats st;
-    const auto& pairs = traverse(st);
-    detail::FeatureContext ca = detail::proximity_context(a.topo, a.x0, h);
-    detail::FeatureContext cb = detail::proximity_context(b.topo, b.x0, h);
+    const detail::PairList pairs = traverse(st);
+    detail::FeatureContext ca = detail::proximity_context(a.topo, a.v0, h);
+    detail::FeatureContext cb = detail::proximity_context(b.topo, b.v0, h);
     a.boxes.update(ca, a.step);
     b.boxes.update(cb, b.step);
     const auto& faces_a = a.topo.faces();
     const auto& faces_b = b.topo.faces();
     const auto& edges_a = a.topo.edges();
     const auto& edges_b = b.topo.edges();
-    struct Found {
+    struct Found : detail::LoopBuffers {
       std::vector<ProximityResult::VertexFace> ab, ba;
       std::vector<ProximityResult::EdgeEdge> ee;
-      detail::FaceBoundBatch bounds;  // triangle pairs, bounded a batch at a time
     };
     tbb::enumerable_thread_specific<Found> locals;
     const Scope scope{*this};
-    const auto& xa = a.x0;
-    const auto& xb = b.x0;
-    constexpr std::size_t kBatch = detail::FaceBoundBatch::kCapacity;
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, pairs.size(), kBatch),
-        [&](const tbb::blocked_range<std::size_t>& r) {
-          Found& out = locals.local();
-          detail::FaceBoundBatch& nb = out.bounds;
-          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const auto [f, g] = pairs[i];
-            // No feature pair is closer than the whole triangles' bound, computed for a batch
-            // of pairs at a time.
-            const std::size_t k = (i - r.begin()) % kBatch;
-            if (k == 0) {
-              const std::size_t end = std::min(r.end(), i + kBatch);
-              for (std::size_t j = i; j != end; ++j)
-                nb.push(xa, faces_a[pairs[j].first], xb, faces_b[pairs[j].second]);
-              nb.run();
-            }
-            if (nb.bound[k] > h) continue;
-            face_pair(
-                ca, cb, f, g, scope,
-                [&](int v, int k) {
-                  const Face& t = faces_b[k];
-                  const double d =
-                      ccd_detail::point_triangle_within(xa[v], xb[t[0]], xb[t[1]], xb[t[2]], h);
-                  if (d <= h) out.ab.push_back({v, k, d});
-                },
-                [&](int u, int k) {
-                  const Face& t = faces_a[k];
-                  const double d =
-                      ccd_detail::point_triangle_within(xb[u], xa[t[0]], xa[t[1]], xa[t[2]], h);
-                  if (d <= h) out.ba.push_back({u, k, d});
-                },
-                [&](int x, int y) {
-                  const Edge &p = edges_a[x], &q = edges_b[y];
-                  const double d =
-                      ccd_detail::edge_edge_within(xa[p[0]], xa[p[1]], xb[q[0]], xb[q[1]], h);
-                  if (d <= h) out.ee.push_back({x, y, d});
-                });
-          }
-        });
+    const auto& xa = a.v0;
+    const auto& xb = b.v0;
+    // No feature pair is closer than the whole triangles' bound.
+    detail::LoopPlan plan;
+    plan.filter = detail::TriangleFilter::Static;
+    plan.distance = h;
+    pair_loop(pairs, loop_side(a, ca), loop_side(b, cb), plan, locals, no_fetch,
+              [&](int f, int g, Found& out) {
+                face_pair(
+                    ca, cb, f, g, scope,
+                    [&](int v, int k) {
+                      const Face& t = faces_b[k];
+                      const double d =
+                          ccd_detail::point_triangle_within(xa[v], xb[t[0]], xb[t[1]], xb[t[2]], h);
+                      if (d <= h) out.ab.push_back({v, k, d});
+                    },
+                    [&](int u, int k) {
+                      const Face& t = faces_a[k];
+                      const double d =
+                          ccd_detail::point_triangle_within(xb[u], xa[t[0]], xa[t[1]], xa[t[2]], h);
+                      if (d <= h) out.ba.push_back({u, k, d});
+                    },
+                    [&](int x, int y) {
+                      const Edge &p = edges_a[x], &q = edges_b[y];
+                      const double d =
+                          ccd_detail::edge_edge_within(xa[p[0]], xa[p[1]], xb[q[0]], xb[q[1]], h);
+                      if (d <= h) out.ee.push_back({x, y, d});
+                    });
+              });
     PairProximityResult res;
     for (const auto& l : locals) {
       res.vf_a_on_b.insert(res.vf_a_on_b.end(), l.ab.begin(), l.ab.end());
@@ -475,11 +394,10 @@ void rebuild_detector(Impl& m, detail::PointsIn reference_a, detail::PointsIn re
   std::vector<Eigen::Vector3d> ra, rb;
   detail::to_points(reference_a, m.a.topo.num_vertices(), "reference shape A", ra);
   detail::to_points(reference_b, m.b.topo.num_vertices(), "reference shape B", rb);
-  m.a.bvh = Bvh::boxes_only(m.a.topo, ra, m.opt.build);
-  m.b.bvh = Bvh::boxes_only(m.b.topo, rb, m.opt.build);
-  m.a.bvh_call = m.b.bvh_call = 0;
-  m.restricted = false;  // its node flags belonged to the old trees
-  m.front.clear();       // and so did the front's node pairs
+  // Both references are checked before either tree changes.
+  m.a.rebuild(std::span<const Eigen::Vector3d>(ra), "reference shape A", m.opt.build, false);
+  m.b.rebuild(std::span<const Eigen::Vector3d>(rb), "reference shape B", m.opt.build, false);
+  m.front.clear();  // the front's node pairs belonged to the old trees
 }
 }  // namespace
 
@@ -538,12 +456,17 @@ EarliestImpact PairDetector::earliest_impact(std::span<const Eigen::Vector3d> a_
 void PairDetector::set_active_vertices(std::span<const int> vertices_a,
                                        std::span<const int> vertices_b) {
   Impl& m = *impl_;
-  m.a.set_active(vertices_a, "A");
-  m.b.set_active(vertices_b, "B");
-  m.restricted = true;
+  m.a.set_active_vertices(vertices_a, "A");
+  try {
+    m.b.set_active_vertices(vertices_b, "B");
+  } catch (...) {
+    m.a.clear_active();  // the restriction holds on both meshes or on neither
+    throw;
+  }
 }
 void PairDetector::clear_active() {
-  impl_->restricted = false;
+  impl_->a.clear_active();
+  impl_->b.clear_active();
 }
 void PairDetector::rebuild(const Positions& reference_a, const Positions& reference_b) {
   rebuild_detector(*impl_, reference_a, reference_b);

@@ -1,12 +1,13 @@
 #pragma once
-// The self detector's state and stages (SelfDetector's implementation): one mesh's topology,
-// tree, step positions, feature boxes and active restriction, and the stages a detection runs
-// through them in order: refit (detector.cpp), culled traversal (self_traverse.cpp), narrow phase
-// over the triangle pairs and the orphans (self_narrow.cpp), finish. proximity() lives in
+// The self detector's state and stages (SelfDetector's implementation): one mesh state
+// (mesh_state.hpp) and the stages a detection runs through it in order: refit (detector.cpp),
+// culled traversal (self_traverse.cpp), narrow phase over the triangle pairs (the pair loop of
+// pair_loop.hpp) and the orphans (self_narrow.cpp), finish. proximity() lives in
 // self_proximity.cpp. The research module (src/research) drives the same stages with its unsound
 // rules, optimal cones and many configurations at once.
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 
 #include <chrono>
 #include <cstdint>
@@ -21,9 +22,10 @@
 #include "bvh/front.hpp"
 #include "bvh/traversal.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "detect/mesh_state.hpp"
 #include "detect/narrow.hpp"
 #include "detect/orphans.hpp"
-#include "detect/pair_list.hpp"
+#include "detect/pair_loop.hpp"
 #include "detect/positions.hpp"
 
 namespace clothcd::detail {
@@ -44,14 +46,12 @@ struct PairBuffer {
 };
 using PairLocals = tbb::enumerable_thread_specific<PairBuffer>;
 
-/// One thread's share of a narrow phase.
-struct NarrowBuffer {
-  FeatureCounters c;
+/// One thread's share of a CCD narrow phase: the pair loop's batches, and the feature pairs
+/// queued for the batch filters and kernels.
+struct NarrowBuffer : LoopBuffers {
   std::vector<VertexFaceCollision> vf;
   std::vector<EdgeEdgeCollision> ee;
-  FeatureBatch batch;     // the pair loop's feature pairs, NP-filtered a batch at a time
-  FacesApartBatch faces;  // its triangle pairs, distance-filtered a batch at a time
-  FaceBoundBatch near;    // ... those whose boxes miss, bounded at t1 a batch at a time
+  FeatureBatch batch;
 };
 using NarrowLocals = tbb::enumerable_thread_specific<NarrowBuffer>;
 
@@ -74,28 +74,13 @@ void check_self_options(const DetectOptions& o);
 /// Refuses options naming a build other than the tree's (it is built once, at construction).
 void check_same_build(BvhBuild built, BvhBuild asked, std::string_view call);
 
-struct SelfCore {
+/// The self detector: one mesh state, the options, and what the culled traversal and the
+/// proximity query keep from call to call.
+struct SelfCore : MeshState {
   using Rule = CullRule;
 
-  Topology topo;
   DetectOptions opt;
-  Bvh bvh;
   Orphans orphans;
-  // The positions of the last call, and which vertices changed since the call before: one copy
-  // and one comparison a call, shared by the refit and the feature boxes.
-  StepPositions step;
-  const std::vector<Eigen::Vector3d>& v0 = step.x0();
-  const std::vector<Eigen::Vector3d>& v1 = step.x1();
-  std::uint64_t bvh_call = 0;
-  // the call of `step` the tree was last swept at (0: none)
-  // Active restriction: features on active faces, and the nodes holding a face that touches one.
-  // `outside` turns it into its complement (the pairs the restriction leaves out).
-  bool restricted = false;
-  bool outside = false;
-  std::vector<std::uint8_t> face_active, vertex_active, edge_active, node_active;
-  // Swept boxes of the features, updated where vertices moved (see FeatureBoxes), also gathered
-  // per face for the pair loop.
-  FeatureBoxes boxes{true};
   // opt.linked_vertices normalized by the first detect() after construction or set_options (a
   // bad id throws there, and again at every call until the options change).
   std::vector<std::pair<int, int>> links;
@@ -120,8 +105,6 @@ struct SelfCore {
   // module; and whether the refit computes the optimal cones (research only).
   Rule cull = Rule::None;
   bool optimal_cones = false;
-  // Set by earliest_impact() for its windows only (FeatureContext::filters_only).
-  bool window_filters_only = false;
 
   SelfCore(std::vector<Face> faces, int nv, PointsIn ref, const DetectOptions& o);
   /// Replaces the options (checked; the build must stay) and resets what depended on them.
@@ -170,11 +153,13 @@ struct SelfCore {
   // end_reach (the step-end test of end_reach()); either test is skipped where its reach is < 0.
   [[nodiscard]] bool corners_clear(const BvhNode& n, double cosine, double reach,
                                    double end_reach = -1) const;
-  [[nodiscard]] bool vf_in_scope(int v, int f) const {
-    return !restricted || ((vertex_active[v] != 0 || face_active[f] != 0) != outside);
+  [[nodiscard]] bool vf_in_scope(Scope s, int v, int f) const {
+    return s == Scope::All ||
+           ((vertex_active[v] != 0 || face_active[f] != 0) == (s == Scope::Active));
   }
-  [[nodiscard]] bool ee_in_scope(int ea, int eb) const {
-    return !restricted || ((edge_active[ea] != 0 || edge_active[eb] != 0) != outside);
+  [[nodiscard]] bool ee_in_scope(Scope s, int ea, int eb) const {
+    return s == Scope::All ||
+           ((edge_active[ea] != 0 || edge_active[eb] != 0) == (s == Scope::Active));
   }
   // Whether the self test of internal node i is skipped under `mode` (the cones of the last
   // refit): counts the cone and contour tests it makes.
@@ -196,12 +181,14 @@ struct SelfCore {
     };
   }
   // Overlapping non-adjacent leaf pairs of the culled self traversal, held in `locals` (emptied
-  // first) until the next traversal into them. `from_front` (unrestricted calls only): from the
-  // front of the last call that used one, which it replaces (DetectOptions::reuse_front): the
-  // same leaf pairs and self tests; only the pairs' order and the box tests differ.
-  PairList traverse(Rule mode, DetectStats& st, PairLocals& locals, bool from_front = false);
+  // first) until the next traversal into them; below the active nodes only for Scope::Active.
+  // `from_front` (Scope::All only): from the front of the last call that used one, which it
+  // replaces (DetectOptions::reuse_front): the same leaf pairs and self tests; only the pairs'
+  // order and the box tests differ.
+  PairList traverse(Rule mode, Scope scope, DetectStats& st, PairLocals& locals,
+                    bool from_front = false);
   // traverse()'s walk from the root, in parallel over a frontier of tasks.
-  TraversalCounters traverse_root(Rule mode, PairLocals& locals);
+  TraversalCounters traverse_root(Rule mode, Scope scope, PairLocals& locals);
   // traverse()'s walk from the front: first the self tests the walk from the root makes, a level
   // at a time (bit 0 of front_live[n]: the self test of n runs, its parent's did and was not
   // culled; bit 1: n is internal and not culled, so the pairs of its children are traversed),
@@ -212,13 +199,41 @@ struct SelfCore {
   }
   // The feature pairs of `pairs` and of the orphans that collide (ctx's boxes are up to date).
   // With `near`, also flags the pairs whose faces are at most opt.reuse_distance apart at t1.
-  void narrow(const FeatureContext& ctx, const PairList& pairs, DetectResult& res,
+  void narrow(const FeatureContext& ctx, const PairList& pairs, Scope scope, DetectResult& res,
               std::vector<std::uint8_t>* near = nullptr);
   // The feature pairs of the triangle pairs `pairs` that collide, into `locals`.
-  void narrow_pairs(const FeatureContext& ctx, const PairList& pairs, NarrowLocals& locals,
-                    std::vector<std::uint8_t>* near = nullptr) const;
+  void narrow_pairs(const FeatureContext& ctx, const PairList& pairs, Scope scope,
+                    NarrowLocals& locals, std::vector<std::uint8_t>* near = nullptr) const;
   // The orphan feature pairs that collide, into `locals`.
-  void narrow_orphans(const FeatureContext& ctx, NarrowLocals& locals) const;
+  void narrow_orphans(const FeatureContext& ctx, Scope scope, NarrowLocals& locals) const;
+  // The in-scope orphan pairs whose boxes overlap, to kvf(v, f, t, out) and kee(a, b, ea, eb,
+  // out), `out` a thread's buffer of `locals`.
+  template <class Locals, class KernelVf, class KernelEe>
+  void orphan_pairs(const FeatureContext& ctx, Scope scope, Locals& locals, KernelVf&& kvf,
+                    KernelEe&& kee) const {
+    const auto& faces = topo.faces();
+    const auto& edges = topo.edges();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.vf.size(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        auto& out = locals.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const auto [v, f] = orphans.vf[i];
+                          if (!vf_in_scope(scope, v, f)) continue;
+                          if (!overlap(ctx.vertex_box(v), ctx.face_box(f))) continue;
+                          kvf(v, f, faces[f], out);
+                        }
+                      });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.ee.size(), 256),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        auto& out = locals.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          const auto [ea, eb] = orphans.ee[i];
+                          if (!ee_in_scope(scope, ea, eb)) continue;
+                          if (!overlap(ctx.edge_box(ea), ctx.edge_box(eb))) continue;
+                          kee(ea, eb, edges[ea], edges[eb], out);
+                        }
+                      });
+  }
   // Adds the buffers' counters and collisions to `res` (left unsorted).
   static void gather(const NarrowLocals& locals, DetectResult& res);
   // Sorts the collisions and counts them, and the orphans every detection checks.
@@ -226,21 +241,40 @@ struct SelfCore {
   // Tests the feature pairs of a non-adjacent triangle pair whose representative pair it is.
   // Needs the context's precomputed boxes and face blocks (`boxes` keeps both).
   template <class Out, class KernelVf, class KernelEe>
-  void triangle_pair(const FeatureContext& ctx, int f, int g, Out& out, KernelVf&& kvf,
+  void triangle_pair(const FeatureContext& ctx, Scope scope, int f, int g, Out& out, KernelVf&& kvf,
                      KernelEe&& kee) const {
     owned_feature_pairs(
         owner, StepFaceBoxes{ctx}, f, g,
         [&](int v, int face, const Face& t) {
-          if (vf_in_scope(v, face)) kvf(v, face, t, out);
+          if (vf_in_scope(scope, v, face)) kvf(v, face, t, out);
         },
         [&](int e1, int e2, const Edge& a, const Edge& b) {
-          if (ee_in_scope(e1, e2)) kee(e1, e2, a, b, out);
+          if (ee_in_scope(scope, e1, e2)) kee(e1, e2, a, b, out);
         });
+  }
+  // The pair loop's sides (both this mesh) for the context's positions and boxes.
+  [[nodiscard]] LoopSide loop_side(const FeatureContext& ctx) const {
+    return {ctx.v0, ctx.v1, &topo.faces(), ctx.face_boxes, ctx.fboxes};
+  }
+  // The pair loop's prefetch of faces f's and g's ownership records and box blocks. Inlined
+  // always: a function of prefetches alone counts as free of side effects, and its calls would
+  // be dropped.
+  [[nodiscard]] auto fetch(const FeatureContext& ctx) const {
+    return [ this, &ctx ](int f, int g) __attribute__((always_inline)) {
+      for (int h : {f, g}) {
+        prefetch(&owner.record(h));
+        const auto* block = reinterpret_cast<const char*>(&ctx.face_boxes[h]);
+        for (int line = 0; line < 3; ++line)
+          prefetch(block + 64 * line);
+      }
+    };
   }
   // Boxes and cones for the current options, where vertices moved since the last refit (all of
   // it when the refit options changed).
   void refit(DetectStats& st);
-  DetectResult detect(PointsIn p0, PointsIn p1);
+  // `kernels` false: every pair the filters keep is a hit at time 0 (FilterPlan::kernel), for
+  // the earliest-impact query's windows.
+  DetectResult detect(PointsIn p0, PointsIn p1, bool kernels = true);
   ProximityResult proximity(PointsIn p, double h);
   // detect() over time windows, reduced to the earliest hit (earliest.cpp).
   EarliestImpact earliest_impact(PointsIn p0, PointsIn p1, const EarliestOptions& o);
@@ -248,13 +282,6 @@ struct SelfCore {
   // vertices that moved since (few, or the traversal is cheaper). `reuse.valid` implies keeps():
   // only detect() sets it, and set_options() clears it.
   bool reusable(double h);
-  void set_active(std::span<const int> active_faces);
-  // Scope by vertices: a VF pair when its vertex or a vertex of its face is active, an EE pair
-  // when an endpoint is active. A face then counts as active when it has an active vertex, and
-  // only such faces can represent an in-scope pair.
-  void set_active_vertices(std::span<const int> active_vertices);
-  // Nodes holding a face that can represent an in-scope pair.
-  void set_nodes(const std::vector<std::uint8_t>& touch);
 };
 
 /// The core of a SelfDetector, for the research module (src/research), which drives its stages.

@@ -1,8 +1,7 @@
 // The self detector's proximity query: the box traversal at distance h (or the pairs kept by
-// the last detect() for the vertices still where it left them), then the triangles' bound and
-// the distance of every owned feature pair within reach.
-
-#include <tbb/parallel_for.h>
+// the last detect() for the vertices still where it left them), then the pair loop
+// (pair_loop.hpp) with the triangles' bound and the distance of every owned feature pair within
+// reach.
 
 #include <algorithm>
 #include <cmath>
@@ -11,63 +10,45 @@
 #include "detect/self_core.hpp"
 
 namespace clothcd::detail {
+namespace {
+struct ProximityBuffer : LoopBuffers {
+  std::vector<ProximityResult::VertexFace> vf;
+  std::vector<ProximityResult::EdgeEdge> ee;
+};
+}  // namespace
 
-ProximityResult SelfCore::proximity(detail::PointsIn p, double h) {
+ProximityResult SelfCore::proximity(PointsIn p, double h) {
   if (!(h >= 0) || !std::isfinite(h)) {
     throw InputError(fmt::format("proximity distance must be finite and >= 0, got {}", h));
   }
   step.update_static(p, topo.num_vertices(), "positions");
   update_links();
-  RefitOptions ro;
-  ro.thickness = h;
-  ro.cones = false;  // cones carry no distance information (docs/algorithms.md 1.1)
-  bvh.refit(v0, ro);
-  bvh_call = 0;
-  detail::FeatureContext ctx = detail::proximity_context(topo, v0, h, links);
+  refit_static(h);
+  FeatureContext ctx = proximity_context(topo, v0, h, links);
   boxes.update(ctx, step);
-  struct Buffer {
-    std::vector<ProximityResult::VertexFace> vf;
-    std::vector<ProximityResult::EdgeEdge> ee;
-    detail::FaceBoundBatch bounds;  // a piece's triangle pairs past the box test
-  };
-  tbb::enumerable_thread_specific<Buffer> locals;
+  tbb::enumerable_thread_specific<ProximityBuffer> locals;
   // Linked pairs are left out as detect() leaves them out (DetectOptions::linked_vertices).
-  auto kvf = [&](int v, int f, const Face& t, Buffer& out) {
+  auto kvf = [&](int v, int f, const Face& t, ProximityBuffer& out) {
     if (!ctx.links.empty() && ctx.vf_linked(v, f)) return;
     const double d = ccd_detail::point_triangle_within(v0[v], v0[t[0]], v0[t[1]], v0[t[2]], h);
     if (d <= h) out.vf.push_back({v, f, d});
   };
-  auto kee = [&](int a, int b, const Edge& ea, const Edge& eb, Buffer& out) {
+  auto kee = [&](int a, int b, const Edge& ea, const Edge& eb, ProximityBuffer& out) {
     if (!ctx.links.empty() && ctx.ee_linked(a, b)) return;
     const double d = ccd_detail::edge_edge_within(v0[ea[0]], v0[ea[1]], v0[eb[0]], v0[eb[1]], h);
     if (d <= h) out.ee.push_back({a, b, d});
   };
-  // A piece at a time: the box test, the whole triangles' bound of the pairs past it at once
-  // (no feature pair is closer), then the feature pairs of those within h, in list order.
-  auto test_pairs = [&](const detail::PairList& pairs) {
-    const std::vector<detail::PairList::Piece> pieces =
-        pairs.pieces(detail::FaceBoundBatch::kCapacity);
-    const auto& faces = topo.faces();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces.size(), 1),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        Buffer& out = locals.local();
-                        detail::FaceBoundBatch& nb = out.bounds;
-                        for (std::size_t p = r.begin(); p != r.end(); ++p) {
-                          const std::span<const detail::FacePair> piece = pieces[p].pairs;
-                          for (std::size_t k = 0; k < piece.size(); ++k) {
-                            const auto [f, g] = piece[k];
-                            nb.slot[k] = detail::overlap(ctx.fboxes[f], ctx.fboxes[g])
-                                             ? nb.push(v0, faces[f], v0, faces[g])
-                                             : -1;
-                          }
-                          nb.run();
-                          for (std::size_t k = 0; k < piece.size(); ++k) {
-                            const int s = nb.slot[k];
-                            if (s < 0 || nb.bound[s] > h) continue;
-                            triangle_pair(ctx, piece[k].first, piece[k].second, out, kvf, kee);
-                          }
-                        }
-                      });
+  // The box test, the whole triangles' bound (no feature pair is closer), then the feature
+  // pairs of the triangle pairs within h.
+  LoopPlan plan;
+  plan.filter = TriangleFilter::Static;
+  plan.distance = h;
+  plan.box_test = true;
+  const LoopSide side = loop_side(ctx);
+  const auto test_pairs = [&](const PairList& pairs, Scope scope) {
+    pair_loop(pairs, side, side, plan, locals, fetch(ctx), [&](int f, int g, ProximityBuffer& out) {
+      triangle_pair(ctx, scope, f, g, out, kvf, kee);
+    });
   };
   DetectStats st;
   std::size_t reused = 0;
@@ -77,27 +58,15 @@ ProximityResult SelfCore::proximity(detail::PointsIn p, double h) {
     // vertices finds the rest. The two scopes split the feature pairs exactly.
     struct Unrestrict {
       SelfCore& im;
-      ~Unrestrict() { im.restricted = im.outside = false; }
+      ~Unrestrict() { im.clear_active(); }
     } unrestrict{*this};
-    outside = true;
-    test_pairs(detail::PairList(reuse.pairs));
+    test_pairs(PairList(reuse.pairs), Scope::Inactive);
     reused = reuse.pairs.size();
-    outside = false;
-    test_pairs(traverse(Rule::None, st, pair_locals));
+    test_pairs(traverse(Rule::None, Scope::Active, st, pair_locals), Scope::Active);
   } else {
-    test_pairs(traverse(Rule::None, st, pair_locals));
+    test_pairs(traverse(Rule::None, scope(), st, pair_locals), scope());
   }
-  Buffer& out = locals.local();
-  for (const auto& [v, f] : orphans.vf) {
-    if (vf_in_scope(v, f) && detail::overlap(ctx.vertex_box(v), ctx.face_box(f))) {
-      kvf(v, f, topo.faces()[f], out);
-    }
-  }
-  for (const auto& [a, b] : orphans.ee) {
-    if (ee_in_scope(a, b) && detail::overlap(ctx.edge_box(a), ctx.edge_box(b))) {
-      kee(a, b, topo.edges()[a], topo.edges()[b], out);
-    }
-  }
+  orphan_pairs(ctx, scope(), locals, kvf, kee);
   ProximityResult res;
   res.reused_pairs = reused;
   for (const auto& l : locals) {
@@ -121,7 +90,7 @@ bool SelfCore::reusable(double h) {
     if (v0[i] != reuse.x1[i]) moved.push_back(i);
   }
   if (4 * moved.size() > static_cast<std::size_t>(nv)) return false;
-  set_active_vertices(moved);
+  set_active_vertices(moved, "");
   return true;
 }
 

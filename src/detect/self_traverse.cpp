@@ -87,7 +87,7 @@ bool SelfCore::culls(Rule mode, int i, detail::TraversalCounters& c) const {
   return ok;
 }
 
-detail::PairList SelfCore::traverse(Rule mode, DetectStats& st, PairLocals& locals,
+detail::PairList SelfCore::traverse(Rule mode, Scope scope, DetectStats& st, PairLocals& locals,
                                     bool from_front) {
   for (PairBuffer& l : locals) {
     l.pairs.clear();
@@ -96,7 +96,7 @@ detail::PairList SelfCore::traverse(Rule mode, DetectStats& st, PairLocals& loca
   detail::PairList pairs;
   if (bvh.nodes().empty()) return pairs;
   const detail::TraversalCounters c =
-      from_front ? traverse_front(mode, locals) : traverse_root(mode, locals);
+      from_front ? traverse_front(mode, locals) : traverse_root(mode, scope, locals);
   st.box_tests = c.box_tests;
   st.nodes_culled = c.culled;
   st.cone_tests = c.cone_tests;
@@ -110,11 +110,11 @@ detail::PairList SelfCore::traverse(Rule mode, DetectStats& st, PairLocals& loca
   return pairs;
 }
 
-detail::TraversalCounters SelfCore::traverse_root(Rule mode, PairLocals& locals) {
+detail::TraversalCounters SelfCore::traverse_root(Rule mode, Scope scope, PairLocals& locals) {
   const auto& nodes = bvh.nodes();
   auto cull = [&](int i, detail::TraversalCounters& c) { return culls(mode, i, c); };
   std::span<const std::uint8_t> act;
-  if (restricted) act = node_active;
+  if (scope == Scope::Active) act = node_active;
   auto tr = detail::make_traversal(nodes, nodes, act, act, cull, leaf_step());
   return detail::run_parallel(tr, {0, 0, true}, locals);
 }

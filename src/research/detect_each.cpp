@@ -224,14 +224,14 @@ std::vector<clothcd::DetectResult> detect_each_on(detail::SelfCore& m, detail::P
       found[g].stats.adjacent_pairs += gp.adjacent;
       detail::PairList list;
       list.add(gp.pairs);
-      m.narrow_pairs(ctx, list, narrow_locals);
+      m.narrow_pairs(ctx, list, detail::Scope::All, narrow_locals);
     }
     m.gather(narrow_locals, found[g]);
   }
   clothcd::DetectResult orphan_hits;
   {
     detail::NarrowLocals narrow_locals;
-    m.narrow_orphans(ctx, narrow_locals);
+    m.narrow_orphans(ctx, detail::Scope::All, narrow_locals);
     m.gather(narrow_locals, orphan_hits);
   }
   for (std::size_t k = 0; k < configs.size(); ++k) {

@@ -51,10 +51,11 @@ const DetectOptions& checked(const DetectOptions& o) {
 void verify(detail::SelfCore& core, DetectResult& res) {
   clothcd::DetectResult ref;
   detail::PairLocals all_locals;
-  const detail::PairList all = core.traverse(detail::CullRule::None, ref.stats, all_locals);
+  const detail::PairList all =
+      core.traverse(detail::CullRule::None, core.scope(), ref.stats, all_locals);
   detail::FeatureContext ctx = core.ccd_context();
   core.boxes.update(ctx, core.step);
-  core.narrow(ctx, all, ref);
+  core.narrow(ctx, all, core.scope(), ref);
   Verification& ver = res.verification;
   ver.ran = true;
   ver.unculled_triangle_pairs = all.size();

@@ -20,6 +20,7 @@
 
 #include "ccd/face_batch.hpp"
 #include "clothcd/ccd/proximity.hpp"
+#include "support/isa_paths.hpp"
 #include "support/random_gen.hpp"
 
 namespace clothcd::face_batch_test {
@@ -178,12 +179,13 @@ TEST(FaceBatch, EveryInstructionSetGivesTheScalarVerdictAndBoundBitForBit) {
     for (int isa = 1; isa <= 4; ++isa) {
       got.fill(false);
       got_d.fill(-1.0);
-      if (isa == 4) {
-        ccd_detail::triangles_filter_batch(b, thickness, got.data(), got_d.data());
-      } else if (!ccd_detail::triangles_filter_batch_with(isa, b, thickness, got.data(),
-                                                          got_d.data())) {
-        continue;  // the processor lacks it
-      }
+      const bool ran =
+          isa == 4
+              ? (ccd_detail::triangles_filter_batch(b, thickness, got.data(), got_d.data()), true)
+              : ccd_detail::triangles_filter_batch_with(isa, b, thickness, got.data(),
+                                                        got_d.data());
+      test::note_isa("triangles_filter_batch", isa, ran);
+      if (!ran) continue;
       for (int i = 0; i < n; ++i) {
         ASSERT_EQ(got[i], want[i]) << "isa " << isa << " round " << round << " pair " << i;
         ASSERT_EQ(bits(got_d[i]), bits(want_d[i]))
@@ -235,11 +237,10 @@ TEST(FaceBatch, StaticBoundOfEveryInstructionSetIsTheScalarBoundBitForBit) {
     }
     for (int isa = 0; isa <= 4; ++isa) {
       got.fill(-1.0);
-      if (isa == 4) {
-        ccd_detail::triangle_bound_batch(b, got.data());
-      } else if (!ccd_detail::triangle_bound_batch_with(isa, b, got.data())) {
-        continue;
-      }
+      const bool ran = isa == 4 ? (ccd_detail::triangle_bound_batch(b, got.data()), true)
+                                : ccd_detail::triangle_bound_batch_with(isa, b, got.data());
+      test::note_isa("triangle_bound_batch", isa, ran);
+      if (!ran) continue;
       for (int i = 0; i < n; ++i) {
         ASSERT_EQ(bits(got[i]), bits(want[i])) << "isa " << isa << " round " << round;
         ++compared;

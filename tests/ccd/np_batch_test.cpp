@@ -20,6 +20,7 @@
 #include "ccd/np_batch.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "exact_oracle.hpp"
+#include "support/isa_paths.hpp"
 #include "support/random_gen.hpp"
 
 namespace clothcd::np_batch_test {
@@ -109,9 +110,12 @@ std::vector<NpVerdict> check_batch(Kind kind, const std::vector<Points>& qs) {
   for (int isa = 1; isa <= 4; ++isa) {
     got.assign(got.size(), NpVerdict::Undecided);
     if (isa < 4) {
-      if (!ccd_detail::np_filter_batch_with(isa, kind, b, got.data())) continue;
+      const bool ran = ccd_detail::np_filter_batch_with(isa, kind, b, got.data());
+      test::note_isa("np_filter_batch", isa, ran);
+      if (!ran) continue;
     } else {
       ccd_detail::np_filter_batch(kind, b, got.data());
+      test::note_isa("np_filter_batch", isa, true);
     }
     for (std::size_t i = 0; i < qs.size(); ++i) {
       EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " query " << i;
@@ -195,12 +199,13 @@ std::vector<ccd_detail::FastSettled> check_settled(Kind kind, const std::vector<
   for (int isa = 1; isa <= 4; ++isa) {
     std::fill(std::begin(got), std::end(got), FastSettled::Run);
     if (isa < 4) {
-      if (!ccd_detail::fast_path_settle_with(isa, kind, b, verdict.data(), toi_tolerance, got,
-                                             got_toi)) {
-        continue;
-      }
+      const bool ran = ccd_detail::fast_path_settle_with(isa, kind, b, verdict.data(),
+                                                         toi_tolerance, got, got_toi);
+      test::note_isa("fast_path_settle", isa, ran);
+      if (!ran) continue;
     } else {
       ccd_detail::fast_path_settle(kind, b, verdict.data(), toi_tolerance, got, got_toi);
+      test::note_isa("fast_path_settle", isa, true);
     }
     for (std::size_t i = 0; i < qs.size(); ++i) {
       EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " query " << i;
@@ -343,11 +348,13 @@ std::vector<NpVerdict> check_distance(Kind kind, const std::vector<Points>& qs, 
   for (int isa = 1; isa <= 4; ++isa) {
     got = given;
     if (isa < 4) {
-      if (!ccd_detail::distance_filter_batch_with(isa, kind, b, thickness, depth, got.data())) {
-        continue;
-      }
+      const bool ran =
+          ccd_detail::distance_filter_batch_with(isa, kind, b, thickness, depth, got.data());
+      test::note_isa("distance_filter_batch", isa, ran);
+      if (!ran) continue;
     } else {
       ccd_detail::distance_filter_batch(kind, b, thickness, depth, got.data());
+      test::note_isa("distance_filter_batch", isa, true);
     }
     for (std::size_t i = 0; i < qs.size(); ++i)
       EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " depth " << depth << " query " << i;

@@ -93,7 +93,9 @@ TEST(ResearchNames, EveryRuleRoundTripsThroughNamesAndOptions) {
     research::set_cone_rule(o, p);
     EXPECT_EQ(research::cone_rule(o), p);
     EXPECT_EQ(o.research.optimal_cones, p == ConeRule::Optimal);
-    if (p != ConeRule::Optimal) EXPECT_EQ(research::to_string(p), to_string(o.policy));
+    if (p != ConeRule::Optimal) {
+      EXPECT_EQ(research::to_string(p), to_string(o.policy));
+    }
   }
   EXPECT_EQ(research::to_string(CullingRule::None), to_string(Culling::None));
   EXPECT_EQ(research::to_string(CullingRule::Sound), to_string(Culling::Sound));

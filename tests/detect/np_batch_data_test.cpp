@@ -14,6 +14,7 @@
 #include "clothcd/mesh/io.hpp"
 #include "detect/narrow.hpp"
 #include "support/data.hpp"
+#include "support/isa_paths.hpp"
 #include "support/json_file.hpp"
 
 namespace clothcd::np_batch_data_test {
@@ -75,7 +76,9 @@ void compare_verdicts(ccd_detail::Kind kind, const std::vector<std::pair<int, in
       b.push(points_of(pairs[i]));
     ASSERT_TRUE(ccd_detail::np_filter_batch_with(0, kind, b, expect.data()));
     for (int isa = 1; isa <= 3; ++isa) {
-      if (!ccd_detail::np_filter_batch_with(isa, kind, b, got.data())) continue;
+      const bool ran = ccd_detail::np_filter_batch_with(isa, kind, b, got.data());
+      test::note_isa("np_filter_batch", isa, ran);
+      if (!ran) continue;
       for (int i = 0; i < b.size; ++i)
         ASSERT_EQ(got[i], expect[i]) << "isa " << isa << " pair " << start + i;
     }
@@ -138,10 +141,10 @@ void compare_settled(ccd_detail::Kind kind, const std::vector<std::pair<int, int
     EXPECT_TRUE(ccd_detail::fast_path_settle_with(0, kind, b, verdict.data(), opt.toi_tolerance,
                                                   expect, expect_toi));
     for (int isa = 1; isa <= 3; ++isa) {
-      if (!ccd_detail::fast_path_settle_with(isa, kind, b, verdict.data(), opt.toi_tolerance, got,
-                                             got_toi)) {
-        continue;
-      }
+      const bool ran = ccd_detail::fast_path_settle_with(isa, kind, b, verdict.data(),
+                                                         opt.toi_tolerance, got, got_toi);
+      test::note_isa("fast_path_settle", isa, ran);
+      if (!ran) continue;
       for (int i = 0; i < b.size; ++i) {
         EXPECT_EQ(got[i], expect[i]) << "isa " << isa << " pair " << start + i;
         if (got[i] == FastSettled::Hit && expect[i] == FastSettled::Hit) {
@@ -308,7 +311,8 @@ TEST(NpBatchData, QueuedPairsGiveTheScalarResults) {
       o.np_filter = np;
       o.fast_path = fast;
       const detail::FeatureContext ctx = detail::ccd_context(f.topo, f.x0, f.x1, o, sorted);
-      ASSERT_TRUE(ctx.batched_np());
+      ASSERT_NE(ctx.plan.batch, detail::FeatureFilter::None);
+      ASSERT_NE(ctx.plan.batch, detail::FeatureFilter::Distance);
       expect_queued_equal_scalar(ctx, c, 1);
     }
   }
@@ -334,8 +338,7 @@ TEST(NpBatchData, QueuedPairsGiveTheScalarResultsAtAThickness) {
       o.distance_filter_depth = depth;
       o.toi_tolerance = 0.05;
       const detail::FeatureContext ctx = detail::ccd_context(f.topo, f.x0, x1, o);
-      ASSERT_TRUE(ctx.batched());
-      ASSERT_FALSE(ctx.batched_np());
+      ASSERT_EQ(ctx.plan.batch, detail::FeatureFilter::Distance);
       const Tested t = expect_queued_equal_scalar(ctx, c, 16);
       const detail::FeatureCounters& n = t.counters;
       // The filter culls most pairs but not all; the thicker step has collisions.
