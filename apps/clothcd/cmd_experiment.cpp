@@ -45,6 +45,7 @@ struct Args {
   std::string plot_script;
   std::string scenes_dir;
   std::vector<std::string> in_situ;
+  bool in_situ_tables = false;
   int frames = 6;
   int every = 1;
   int timing_every = 0;
@@ -311,6 +312,9 @@ const bool registered = clothcd::app::register_command(
                      "with PROVOT, PROPOSED and EXACT cones, frame by frame in turn, check the "
                      "frames are identical and compare the self CCD's figures")
           ->excludes(scene);
+      sub.add_flag("--in-situ-tables", a->in_situ_tables,
+                   "rewrite the in-situ sections of table1.md and table2.md in the --out folder "
+                   "from the in_situ.csv there, simulating nothing");
       sub.add_option("--frames", a->frames, "frames per scene with --in-situ (default 6)")
           ->check(CLI::PositiveNumber);
       sub.add_option("--steps", a->steps, "at most this many CD calls (frame pairs) per scene")
@@ -349,6 +353,12 @@ const bool registered = clothcd::app::register_command(
                      "plot script (default: scripts/plot_experiment.py of the source tree)");
       sub.add_option("--scenes-dir", a->scenes_dir, "folder of scene files (default: scenes/)");
       return [a, &sub] {
+        if (a->in_situ_tables) {
+          clothcd::app::InSituArgs in;
+          in.out = a->out;
+          in.tables_only = true;
+          return clothcd::app::run_in_situ(in);
+        }
         if (!a->in_situ.empty()) {
           clothcd::app::InSituArgs in;
           in.scenes = a->in_situ;

@@ -87,6 +87,32 @@ template <class Vec>
          2 * kClearanceRounding * scale;
 }
 
+/// triangle_corner_clearance_bound(x0, x1) and the same bound for the step's end alone,
+/// triangle_corner_clearance_bound(x1, x1), from one pass over the corners.
+struct CornerBounds {
+  double step, end;
+};
+[[nodiscard]] inline CornerBounds triangle_corner_clearance_bounds(
+    const std::array<const Eigen::Vector3d*, 3>& x0,
+    const std::array<const Eigen::Vector3d*, 3>& x1) {
+  auto smallest_height = [](const std::array<const Eigen::Vector3d*, 3>& x) {
+    const Eigen::Vector3d ab = *x[1] - *x[0], ac = *x[2] - *x[0], bc = *x[2] - *x[1];
+    const double longest2 = std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
+    return ab.cross(ac).norm() / std::sqrt(longest2);
+  };
+  double rate2 = 0, scale = 0, scale1 = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3;
+    rate2 = std::max(rate2, ((*x1[j] - *x0[j]) - (*x1[i] - *x0[i])).squaredNorm());
+    const double s1 = x1[i]->lpNorm<Eigen::Infinity>();
+    scale = std::max({scale, x0[i]->lpNorm<Eigen::Infinity>(), s1});
+    scale1 = std::max(scale1, s1);
+  }
+  const double h1 = smallest_height(x1);
+  return {0.5 * (smallest_height(x0) + h1 - std::sqrt(rate2)) - 2 * kClearanceRounding * scale,
+          h1 - 2 * kClearanceRounding * scale1};  // 0.5 * (h1 + h1 - 0), exactly
+}
+
 /// True when, projected along the unit `axis`, every vertex of the contour loop stays farther than
 /// `reach` from every loop edge that does not end at it, over the whole step. Pairs of edges whose
 /// swept 2-D boxes, grown by `reach`, do not overlap are apart by more than `reach` throughout;
@@ -100,7 +126,10 @@ template <class Vec>
   if (n < 3) return false;
   const Eigen::Vector3d u = axis.unitOrthogonal();
   const Eigen::Vector3d w = axis.cross(u);
-  std::vector<Eigen::Vector2d> p0(n), p1(n);
+  // Scratch buffers a thread (contour_simple's are its own: no call of one runs inside the other).
+  thread_local std::vector<Eigen::Vector2d> p0, p1;
+  p0.resize(n);
+  p1.resize(n);
   double scale = 0;
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d &x0 = v0[loop[i]], &x1 = v1[loop[i]];

@@ -83,7 +83,11 @@ bool for_each_near_edge_pair(std::span<const Eigen::Vector2d> p0,
     Eigen::Vector2d lo, hi;
     int edge;
   };
-  std::vector<Box> boxes(n);
+  // One scratch buffer a thread: no allocation once it has grown (the traversal tests many
+  // contours a call).
+  thread_local std::vector<Box> scratch;
+  std::vector<Box>& boxes = scratch;
+  boxes.resize(n);
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
     Box& b = boxes[i];
@@ -151,7 +155,9 @@ inline bool contour_simple(std::span<const int> loop, std::span<const Eigen::Vec
   }
   if (!(area > 1e-12 * n * extent * extent)) return false;
 
-  std::vector<Eigen::Vector2d> p0(n), p1(n);
+  thread_local std::vector<Eigen::Vector2d> p0, p1;  // scratch, as in for_each_near_edge_pair
+  p0.resize(n);
+  p1.resize(n);
   for (int i = 0; i < n; ++i) {
     p0[i] = proj(v0[loop[i]]);
     p1[i] = proj(v1[loop[i]]);

@@ -119,8 +119,9 @@ struct SelfCore : MeshState {
   [[nodiscard]] bool cones_used(Rule mode) const { return mode != Rule::None; }
   [[nodiscard]] Rule rule() const { return cull; }
   // Pairs kept for reuse: not with the unsound rules, which may cull close pairs. Sound culling
-  // then certifies its nodes free of feature pairs within reuse_distance too (cull_reach()), so
-  // the list holds every overlapping leaf pair that can matter; the boxes reach reuse_distance.
+  // then certifies its nodes free of feature pairs within reuse_distance at t1 too (end_reach()),
+  // so the list holds every overlapping leaf pair that can matter; the boxes reach
+  // reuse_distance.
   [[nodiscard]] bool keeps() const {
     return opt.reuse_distance > 0 && (rule() == Rule::None || rule() == Rule::Sound);
   }
@@ -129,21 +130,29 @@ struct SelfCore : MeshState {
   }
   // Sound culling with a contact distance (docs/algorithms.md 1.6): at thickness 0 and without
   // reuse, the contour test alone proves a node free of contacts; otherwise a node must also
-  // keep its non-adjacent features farther apart than the node's reach.
+  // keep its non-adjacent features farther apart than the node's reach over the step
+  // (cull_reach(), at thickness > 0) and, where the pairs are kept, than the reuse distance at
+  // t1 (end_reach(), a step without motion: each query at its own reach).
   [[nodiscard]] bool culls_with_reach() const {
     return rule() == Rule::Sound && (opt.thickness > 0 || keeps());
   }
   // How close two features of node n may come before the narrow phase could report them: a
   // kernel hit certifies a distance of at most sqrt(3) (thickness + tolerance * extent), the
-  // extent being at most the node box's longest side; a kept pair matters within reuse_distance.
+  // extent being at most the node box's longest side.
   [[nodiscard]] double cull_reach(const BvhNode& n) const;
+  // How close two features of node n may be at t1 before a later proximity query that takes
+  // the kept pairs could report them: reuse_distance, widened for rounding like cull_reach().
+  [[nodiscard]] double end_reach(const BvhNode& n) const;
   // Whether every triangle below node n keeps, over the current step, its corners more than
   // reach / cosine from their opposite sides (docs/algorithms.md 1.6): cosine times the smallest
   // corner clearance exceeds reach. Computed only for the nodes the traversal asks about (their
   // cones and contours passed), and the nodes it culls are disjoint, so a pass visits few
   // triangles more than once. A triangle's cheap lower bound settles most of them; the others
   // take the exact clearance, so the answer is the exact clearances' bit for bit.
-  [[nodiscard]] bool corners_clear(const BvhNode& n, double cosine, double reach) const;
+  // With `end_reach` >= 0, also cosine times every corner's clearance at t1 alone exceeds
+  // end_reach (the step-end test of end_reach()); either test is skipped where its reach is < 0.
+  [[nodiscard]] bool corners_clear(const BvhNode& n, double cosine, double reach,
+                                   double end_reach = -1) const;
   [[nodiscard]] bool vf_in_scope(Scope s, int v, int f) const {
     return s == Scope::All ||
            ((vertex_active[v] != 0 || face_active[f] != 0) == (s == Scope::Active));

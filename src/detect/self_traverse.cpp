@@ -25,18 +25,34 @@ double SelfCore::cull_reach(const BvhNode& n) const {
     scale = std::max({scale, std::abs(n.lo[k]), std::abs(n.hi[k])});
   }
   const double kernel = std::sqrt(3.0) * (opt.thickness + CcdOptions{}.tolerance * extent);
-  const double reach = std::max(kernel, keeps() ? opt.reuse_distance : 0.0);
-  return reach * (1 + 1e-9) + detail::kClearanceRounding * scale;
+  return kernel * (1 + 1e-9) + detail::kClearanceRounding * scale;
 }
 
-bool SelfCore::corners_clear(const BvhNode& n, double cosine, double reach) const {
+double SelfCore::end_reach(const BvhNode& n) const {
+  double scale = 0;
+  for (int k = 0; k < 3; ++k)
+    scale = std::max({scale, std::abs(n.lo[k]), std::abs(n.hi[k])});
+  return opt.reuse_distance * (1 + 1e-9) + detail::kClearanceRounding * scale;
+}
+
+bool SelfCore::corners_clear(const BvhNode& n, double cosine, double reach,
+                             double end_reach) const {
   const auto& prims = bvh.prim_ids();
   const auto& faces = topo.faces();
+  const bool at_end = end_reach >= 0;  // reach < 0 likewise: the step's test not asked
   for (int k = n.first; k < n.first + n.count; ++k) {
     const Face& f = faces[prims[k]];
     const auto x0 = ccd_detail::corners(v0, f), x1 = ccd_detail::corners(v1, f);
-    if (cosine * detail::triangle_corner_clearance_bound(x0, x1) > reach) continue;
-    if (!(cosine * detail::triangle_corner_clearance(x0, x1) > reach)) return false;
+    // Both bounds from one pass over the corners; the exact clearances only where one fails.
+    const detail::CornerBounds b = detail::triangle_corner_clearance_bounds(x0, x1);
+    if (reach >= 0 && !(cosine * b.step > reach) &&
+        !(cosine * detail::triangle_corner_clearance(x0, x1) > reach)) {
+      return false;
+    }
+    if (at_end && !(cosine * b.end > end_reach) &&
+        !(cosine * detail::triangle_corner_clearance(x1, x1) > end_reach)) {
+      return false;
+    }
   }
   return true;
 }
@@ -55,11 +71,17 @@ bool SelfCore::culls(Rule mode, int i, detail::TraversalCounters& c) const {
   bool ok = detail::contour_star_shaped(bvh.contour(i), v0, v1, k.axis) ||
             detail::contour_simple(bvh.contour(i), v0, v1, k.axis);
   if (ok && culls_with_reach()) {
-    // Projected distances are at least cos(half angle) times the 3-D corner clearances.
-    const double reach = cull_reach(n);
+    // Projected distances are at least cos(half angle) times the 3-D corner clearances. The
+    // step's features against the kernels' reach; where the pairs are kept, also the step's end
+    // alone (the positions a later proximity query reuses) against the reuse distance. At
+    // thickness 0 the contour test has settled the step already.
+    const double reach = opt.thickness > 0 ? cull_reach(n) : -1.0;
+    const double at_end = keeps() && !restricted ? end_reach(n) : -1.0;
     const double cosine = std::cos(k.half_angle);
-    ok = corners_clear(n, cosine, reach) &&
-         detail::contour_clear(bvh.contour(i), v0, v1, k.axis, reach);
+    const std::span<const int> loop = bvh.contour(i);
+    ok = corners_clear(n, cosine, reach, at_end) &&
+         (at_end < 0 || detail::contour_clear(loop, v1, v1, k.axis, at_end)) &&
+         (reach < 0 || detail::contour_clear(loop, v0, v1, k.axis, reach));
   }
   if (!ok) ++c.contour_fails;
   return ok;

@@ -1,6 +1,7 @@
 // The corner clearance's cheap lower bound (triangle_corner_clearance_bound) against the exact
 // clearance it stands in for: never above it, as computed, on random, sliver, far-off and
-// degenerate moving triangles; and close to it when the triangle barely deforms.
+// degenerate moving triangles; close to it when the triangle barely deforms; and the fused
+// bounds of the step and of its end equal the single ones.
 
 #include <gtest/gtest.h>
 
@@ -70,6 +71,25 @@ TEST(CornerClearanceBound, CloseToExactForNearlyRigidMotion) {
   m.x0 = {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, 1, 1)};
   m.x1 = m.x0;
   EXPECT_TRUE(std::isnan(detail::triangle_corner_clearance_bound(m.at0(), m.at1())));
+}
+
+// The fused bounds the culling takes (the step's and its end's, one pass over the corners) are
+// the single bounds bit for bit, NaN where those are NaN: the end's is never above the exact
+// clearance at t1 either, since it is the step bound of a step without motion.
+TEST(CornerClearanceBound, FusedBoundsEqualTheSingleOnes) {
+  std::mt19937_64 rng(11);
+  auto same = [](double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; };
+  for (int k = 0; k < 100000; ++k) {
+    const Moving m = random_moving(rng);
+    const detail::CornerBounds b = detail::triangle_corner_clearance_bounds(m.at0(), m.at1());
+    ASSERT_TRUE(same(b.step, detail::triangle_corner_clearance_bound(m.at0(), m.at1())))
+        << "case " << k;
+    ASSERT_TRUE(same(b.end, detail::triangle_corner_clearance_bound(m.at1(), m.at1())))
+        << "case " << k;
+    if (!std::isnan(b.end)) {
+      ASSERT_LE(b.end, detail::triangle_corner_clearance(m.at1(), m.at1())) << "case " << k;
+    }
+  }
 }
 
 }  // namespace

@@ -205,5 +205,84 @@ TEST(Garments, DressCullThresholdSameResults) {
   }
 }
 
+// A simulator's sequence on the dress with sound culling and pairs kept for reuse: a full pass
+// (its nodes culled at the kernels' reach over the step and at the reuse distance at its end), a
+// restricted pass (the active vertices moved again), the proximity query (the kept pairs and the
+// moved vertices' traversal), then a rebuilt tree, with and without linked vertices. Every pass
+// and query equals a detector without culling or reuse, pair for pair and distance for
+// distance.
+TEST(Garments, DressSoundReuseSequenceEqualsNone) {
+  CLOTHCD_REQUIRE_DATA(root, "garments/dress_knife/drape.obj");
+  const Garment g = load(root, 15656, 29456, 0.002);
+  const double reuse = 1e-3;
+  std::vector<int> active;
+  Positions later = g.p1;
+  for (int v = 0; v < static_cast<int>(later.rows()); v += 11) {
+    active.push_back(v);
+    later(v, 1) += 2e-4;
+  }
+  // Links between close vertex-face pairs of the step's end, as stitches would make them.
+  std::vector<std::pair<int, int>> links;
+  {
+    DetectOptions plain;
+    plain.build = BvhBuild::Patch;
+    SelfDetector probe(g.sewn.faces, g.sewn.num_vertices(), g.p0, plain);
+    const ProximityResult near = probe.proximity(g.p1, reuse);
+    for (std::size_t i = 0; i < near.vf.size(); i += 3)
+      links.emplace_back(near.vf[i].vertex, g.sewn.faces[near.vf[i].face][0]);
+    ASSERT_FALSE(links.empty());
+  }
+  std::uint64_t culled = 0, reused = 0, culled_pairs = 0;
+  for (const bool linked : {false, true}) {
+    DetectOptions plain;
+    plain.thickness = 1e-5;
+    plain.build = BvhBuild::Patch;
+    if (linked) plain.linked_vertices = links;
+    for (ConePolicy policy : {ConePolicy::Provot, ConePolicy::Proposed}) {
+      SCOPED_TRACE(::testing::Message() << "linked " << linked << " policy " << int(policy));
+      DetectOptions o = plain;
+      o.culling = Culling::Sound;
+      o.policy = policy;
+      o.reuse_distance = reuse;
+      SelfDetector det(g.sewn.faces, g.sewn.num_vertices(), g.p0, o);
+      SelfDetector ref(g.sewn.faces, g.sewn.num_vertices(), g.p0, plain);
+      const DetectResult full = det.detect(g.p0, g.p1);
+      const DetectResult full_ref = ref.detect(g.p0, g.p1);
+      EXPECT_EQ(full.vf, full_ref.vf);
+      EXPECT_EQ(full.ee, full_ref.ee);
+      EXPECT_LT(full.stats.triangle_pairs, full_ref.stats.triangle_pairs);
+      culled += full.stats.nodes_culled;
+      culled_pairs += full_ref.stats.triangle_pairs - full.stats.triangle_pairs;
+      det.set_active_vertices(active);
+      ref.set_active_vertices(active);
+      const DetectResult part = det.detect(g.p1, later);
+      const DetectResult part_ref = ref.detect(g.p1, later);
+      EXPECT_EQ(part.vf, part_ref.vf);
+      EXPECT_EQ(part.ee, part_ref.ee);
+      det.clear_active();
+      ref.clear_active();
+      for (const Positions* at : std::array<const Positions*, 2>{&g.p1, &later}) {
+        const ProximityResult p = det.proximity(*at, reuse);
+        const ProximityResult p_ref = ref.proximity(*at, reuse);
+        EXPECT_GT(p.reused_pairs, 0u);
+        reused += p.reused_pairs;
+        EXPECT_EQ(p.vf, p_ref.vf);
+        EXPECT_EQ(p.ee, p_ref.ee);
+      }
+      // A rebuilt tree keeps the pairs kept for reuse (they name faces, not nodes).
+      static_cast<void>(det.detect(g.p0, g.p1));
+      det.rebuild(g.p1);
+      const ProximityResult p = det.proximity(g.p1, reuse);
+      const ProximityResult p_ref = ref.proximity(g.p1, reuse);
+      EXPECT_GT(p.reused_pairs, 0u);
+      EXPECT_EQ(p.vf, p_ref.vf);
+      EXPECT_EQ(p.ee, p_ref.ee);
+    }
+  }
+  EXPECT_GT(culled, 0u);  // the cones were in the loop
+  EXPECT_GT(culled_pairs, 0u);
+  EXPECT_GT(reused, 0u);
+}
+
 }  // namespace garment_test
 }  // namespace clothcd

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
@@ -183,7 +184,8 @@ TEST(Experiment, RowsPerStepAndConfigurationSoundEqualsReference) {
 }
 
 // An in-situ run's per-frame CSV beside the tables adds the per-substep sections: pair tests and
-// CD ms per self-CCD call (sums over the frames / calls), PROPOSED against PROVOT and none.
+// CD ms per self-CCD call (sums over the frames / calls), PROPOSED against PROVOT and none, the
+// paper's rule counted aside beside its 0.75; a later run rewrites those sections alone.
 TEST(Experiment, InSituFiguresJoinTables1And2) {
   const Sequence seq = folding_sheet(4, 2);
   ExperimentOptions opt;
@@ -207,17 +209,53 @@ TEST(Experiment, InSituFiguresJoinTables1And2) {
                          calls);
     }
   }
+  // The paper's rule counted aside: 80 and 60 pairs per call, no times.
+  for (const auto& [setting, pairs] : {std::pair{"cone PROVOT", 80}, {"cone PROPOSED", 60}}) {
+    for (int frame = 1, calls = 2; frame <= 2; ++frame, ++calls) {
+      csv += fmt::format("garment,{},{},{},0,0,{},{},7,0,0,0,0,0,0,0\n", setting, frame, calls,
+                         calls, pairs * calls);
+    }
+  }
   std::ofstream(opt.out / "in_situ.csv") << csv;
   write_reports({seq}, opt);
   const std::string t1 = slurp(opt.out / "table1.md"), t2 = slurp(opt.out / "table2.md");
   check_markdown_tables(t1);
   check_markdown_tables(t2);
-  EXPECT_NE(t1.find("| garment | 2 | 5 | 200 | 100 | 75 | 75 | +25.0% | +62.5% |"),
+  EXPECT_NE(t1.find("| garment | 2 | 5 | 200 | 100 | 75 | 75 | +25.0% | +62.5% | 80 | 60 | 0.750 "
+                    "| 0.75 |"),
             std::string::npos)
       << t1;
-  EXPECT_NE(t2.find("| garment | 2 | 5 | 10.00 | 8.00 | 6.00 | 6.00 | +25.0% | +40.0% |"),
+  EXPECT_NE(t2.find("| garment | 2 | 5 | 10.00 | 8.00 | 6.00 | 6.00 | +25.0% | +40.0% |\n"),
             std::string::npos)
       << t2;
+
+  // An in-situ run rewrites those sections alone (update_in_situ_sections): here with none's
+  // pairs four times as many; every other line of the tables stays.
+  std::string doubled = csv;
+  for (std::size_t at = 0; (at = doubled.find("garment,none,", at)) != std::string::npos;) {
+    std::vector<std::string> f;
+    const std::size_t end = doubled.find('\n', at);
+    std::string line = doubled.substr(at, end - at);
+    for (std::size_t p = 0, q; p <= line.size(); p = q + 1) {
+      q = std::min(line.find(',', p), line.size());
+      f.push_back(line.substr(p, q - p));
+    }
+    f[7] = fmt::format("{}", 4 * std::stoi(f[7]));
+    line = fmt::format("{}", fmt::join(f, ","));
+    doubled.replace(at, end - at, line);
+    at += line.size();
+  }
+  std::ofstream(opt.out / "in_situ.csv") << doubled;
+  EXPECT_EQ(update_in_situ_sections(opt.out).size(), 2u);
+  const std::string u1 = slurp(opt.out / "table1.md"), u2 = slurp(opt.out / "table2.md");
+  EXPECT_NE(u1.find("| garment | 2 | 5 | 800 | 100 | 75 | 75 | +25.0% | +90.6% | 80 | 60 |"),
+            std::string::npos)
+      << u1;
+  EXPECT_EQ(u2, t2);  // no time changed
+  const std::size_t head = t1.find("## Per simulation substep");
+  ASSERT_NE(head, std::string::npos);
+  EXPECT_EQ(u1.substr(0, head), t1.substr(0, head));
+  EXPECT_EQ(std::count(u1.begin(), u1.end(), '\n'), std::count(t1.begin(), t1.end(), '\n'));
 
   // A malformed file names itself and the line.
   std::ofstream(opt.out / "in_situ.csv") << csv << "garment,none,3\n";
@@ -226,7 +264,8 @@ TEST(Experiment, InSituFiguresJoinTables1And2) {
     ADD_FAILURE() << "no error for a short row";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("in_situ.csv"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("10"), std::string::npos) << e.what();
+    const auto line = std::count(csv.begin(), csv.end(), '\n') + 1;  // the short row's
+    EXPECT_NE(std::string(e.what()).find(fmt::format(":{}:", line)), std::string::npos) << e.what();
   }
   fs::remove_all(opt.out);
 }

@@ -36,9 +36,10 @@ TEST(InSitu, ReportsEverySettingOnIdenticalFrames) {
   const auto r = dir.run("experiment --in-situ s.json --frames 3 --threads 1 --out res");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string md = CliScratch::slurp(dir / "res/in_situ.md");
-  for (const char* want : {"clothcd experiment --in-situ s.json --frames 3 --threads 1",
-                           "- commit: ", "- machine: ", "load average", "## swing", "| PROVOT |",
-                           "| PROPOSED |", "| EXACT |", "| none |", "0.75", "0.82"}) {
+  for (const char* want :
+       {"clothcd experiment --in-situ s.json --frames 3 --threads 1",
+        "- commit: ", "- machine: ", "load average", "## swing", "| PROVOT |", "| PROPOSED |",
+        "| EXACT |", "| none |", "0.75", "0.82", "| cone PROVOT |", "| cone PROPOSED |"}) {
     EXPECT_NE(md.find(want), std::string::npos) << want << "\n" << md;
   }
   std::stringstream csv(CliScratch::slurp(dir / "res/in_situ.csv"));
@@ -55,9 +56,9 @@ TEST(InSitu, ReportsEverySettingOnIdenticalFrames) {
   while (std::getline(csv, line))
     rows[split(line)[col["frame"]]][split(line)[col["setting"]]] = split(line);
   ASSERT_EQ(rows.size(), 3u);
-  long long pairs_none = 0, pairs_sound = 0, culled = 0;
+  long long pairs_none = 0, pairs_sound = 0, culled = 0, cone_culled = 0;
   for (const auto& [frame, by] : rows) {
-    ASSERT_EQ(by.size(), 4u) << "frame " << frame;
+    ASSERT_EQ(by.size(), 6u) << "frame " << frame;
     const auto& none = by.at("none");
     EXPECT_EQ(std::stoll(none[col["nodes_culled"]]), 0);
     EXPECT_GT(std::stoll(none[col["self_ccd_calls"]]), 0);
@@ -70,8 +71,17 @@ TEST(InSitu, ReportsEverySettingOnIdenticalFrames) {
       culled += std::stoll(row[col["nodes_culled"]]);
     }
     pairs_none += 3 * std::stoll(none[col["triangle_pairs"]]);
+    // The paper's rule, counted aside on the same full passes.
+    for (const char* s : {"cone PROVOT", "cone PROPOSED"}) {
+      const auto& row = by.at(s);
+      EXPECT_EQ(row[col["self_ccd_calls"]], none[col["self_ccd_calls"]]) << s << " " << frame;
+      EXPECT_LE(std::stoll(row[col["triangle_pairs"]]), std::stoll(none[col["triangle_pairs"]]))
+          << s << " " << frame;
+      cone_culled += std::stoll(row[col["nodes_culled"]]);
+    }
   }
   EXPECT_GT(culled, 0);
+  EXPECT_GT(cone_culled, 0);
   EXPECT_LT(pairs_sound, pairs_none);
 }
 
@@ -109,7 +119,7 @@ TEST(InSitu, SceneFrameCaps) {
   int rows = 0;
   while (std::getline(csv, line))
     ++rows;
-  EXPECT_EQ(rows, 4 * (1 + 2));  // four settings, 1 + 2 frames
+  EXPECT_EQ(rows, 6 * (1 + 2));  // four settings and two counted aside, 1 + 2 frames
   const std::string md = CliScratch::slurp(dir / "res/in_situ.md");
   EXPECT_NE(md.find("- scenes: 2 of 2 done"), std::string::npos) << md;
 }

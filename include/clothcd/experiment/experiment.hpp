@@ -139,6 +139,11 @@ void write_reports(const std::vector<Sequence>& scenes, const ExperimentOptions&
 /// The current date and time, "YYYY-MM-DD HH:MM:SS UTC".
 [[nodiscard]] std::string utc_now();
 
+/// Rewrites the per-substep ("inside the simulator") sections of table1.md and table2.md in
+/// `folder` from the in_situ.csv there (`clothcd experiment --in-situ`), in place, the rest of
+/// each table as it was; a table or CSV that is missing is left alone. Returns the tables
+/// rewritten. Throws InputError for a malformed CSV.
+std::vector<std::filesystem::path> update_in_situ_sections(const std::filesystem::path& folder);
 [[nodiscard]] std::vector<StepRow> read_step_rows(const std::filesystem::path& csv);
 [[nodiscard]] std::vector<SpreadRow> read_spread_rows(const std::filesystem::path& csv);
 

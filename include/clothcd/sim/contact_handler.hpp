@@ -10,6 +10,7 @@
 /// infinite mass, and so have pinned cloth vertices. Processing is sequential over sorted pairs, so
 /// results do not depend on the thread count.
 
+#include <functional>
 #include <memory>
 #include <span>
 
@@ -98,6 +99,11 @@ struct ContactOptions {
   /// one's front of node pairs (DetectOptions::reuse_front). The same pairs, so the same motion;
   /// only the traversal's cost changes (docs/results/front.md).
   bool reuse_front = false;
+  /// A measurement hook, empty by default: when set, called with the cloth's positions at the
+  /// start and the end of the step every full self CCD pass detects (the passes SelfCcdFigures
+  /// counts), before the pass. It sees the motion and changes nothing (`clothcd experiment
+  /// --in-situ` counts there what other culling rules would test).
+  std::function<void(std::span<const Vec3> x0, std::span<const Vec3> x1)> on_full_self_pass;
 };
 
 /// What the self detector's full CCD passes cost, summed over calls: the passes that test every

@@ -105,6 +105,7 @@ CcdHits::Hit CcdHits::settle(double sep_scale, bool dropped, bool tangled, doubl
 
 void CcdHits::self_hits(std::span<const Vec3> x1, std::span<const Vec3> v,
                         const std::vector<int>* active, double sep_scale, CcdPass& out) {
+  if (active == nullptr && opt_.on_full_self_pass) opt_.on_full_self_pass(g_.x0, x1);
   // The restriction to the active vertices is the detector's work too.
   const DetectResult r = [&] {
     PartClock clock(out.times.ccd_self_s);
