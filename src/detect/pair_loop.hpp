@@ -73,77 +73,83 @@ void pair_loop(const PairList& pairs, const LoopSide& a, const LoopSide& b, cons
     return overlap(a.fboxes[f], b.fboxes[g]);
   };
   // Pairs [k0, k1) of a piece whose first pair is pair `first` of the list: the box test and
-  // the queueing of the pairs past it, the filter on them at once, then their features.
-  const auto chunk = [&](std::size_t first, std::span<const FacePair> piece, std::size_t k0,
-                         std::size_t k1, Local& out) {
-    FacesApartBatch& ap = out.apart;
-    FaceBoundBatch& bd = out.bound;
-    std::array<bool, kBatch> past{};
-    for (std::size_t k = k0; k < k1; ++k) {
-      // Written here, not in a helper: a function of prefetches alone counts as free of side
-      // effects, and the compiler drops its calls.
-      if (k + kFar < piece.size()) fetch(piece[k + kFar].first, piece[k + kFar].second);
-      const auto [f, g] = piece[k];
-      const std::size_t s = k - k0;
-      ap.slot[s] = bd.slot[s] = -1;
-      past[s] = !plan.box_test || boxes_meet(f, g);
-      if (!past[s]) {
-        if (plan.near != nullptr) bd.slot[s] = bd.push(a.x1, fa[f], b.x1, fb[g]);
-        continue;
-      }
-      switch (plan.filter) {
-        case TriangleFilter::Swept:
-          ap.slot[s] = ap.push(a.x0, a.x1, fa[f], b.x0, b.x1, fb[g]);
-          break;
-        case TriangleFilter::Static:
-          bd.slot[s] = bd.push(a.x0, fa[f], b.x0, fb[g]);
-          break;
-        case TriangleFilter::None:
+  // the queueing of the pairs past it, the filter on them at once, then their features. One
+  // loop per filter, chosen once per call: no per-pair switch.
+  const auto run = [&]<TriangleFilter kFilter>() {
+    const auto chunk = [&](std::size_t first, std::span<const FacePair> piece, std::size_t k0,
+                           std::size_t k1, Local& out) {
+      FacesApartBatch& ap = out.apart;
+      FaceBoundBatch& bd = out.bound;
+      std::array<bool, kBatch> past{};
+      for (std::size_t k = k0; k < k1; ++k) {
+        // Written here, not in a helper: a function of prefetches alone counts as free of side
+        // effects, and the compiler drops its calls.
+        if (k + kFar < piece.size()) fetch(piece[k + kFar].first, piece[k + kFar].second);
+        const auto [f, g] = piece[k];
+        const std::size_t s = k - k0;
+        ap.slot[s] = bd.slot[s] = -1;
+        past[s] = !plan.box_test || boxes_meet(f, g);
+        if (!past[s]) {
           if (plan.near != nullptr) bd.slot[s] = bd.push(a.x1, fa[f], b.x1, fb[g]);
-          break;
+          continue;
+        }
+        if constexpr (kFilter == TriangleFilter::Swept) {
+          ap.slot[s] = ap.push(a.x0, a.x1, fa[f], b.x0, b.x1, fb[g]);
+        } else if constexpr (kFilter == TriangleFilter::Static) {
+          bd.slot[s] = bd.push(a.x0, fa[f], b.x0, fb[g]);
+        } else {
+          if (plan.near != nullptr) bd.slot[s] = bd.push(a.x1, fa[f], b.x1, fb[g]);
+        }
       }
-    }
-    if (ap.pairs.size > 0) ap.run(plan.distance);
-    if (bd.pairs.size > 0) bd.run();
-    for (std::size_t k = k0; k < k1; ++k) {
-      const std::size_t s = k - k0;
-      const int sa = ap.slot[s], sb = bd.slot[s];
-      std::uint8_t* near = plan.near != nullptr ? plan.near->data() + first + k : nullptr;
-      if (!past[s]) {
-        if (near != nullptr) *near = !(bd.bound[sb] > plan.near_distance);
-        continue;
-      }
-      ++out.c.triangle_pairs;
-      switch (plan.filter) {
-        case TriangleFilter::Swept:
+      if (ap.pairs.size > 0) ap.run(plan.distance);
+      if (bd.pairs.size > 0) bd.run();
+      for (std::size_t k = k0; k < k1; ++k) {
+        const std::size_t s = k - k0;
+        const int sa = ap.slot[s], sb = bd.slot[s];
+        std::uint8_t* near = plan.near != nullptr ? plan.near->data() + first + k : nullptr;
+        if (!past[s]) {
+          if (near != nullptr) *near = !(bd.bound[sb] > plan.near_distance);
+          continue;
+        }
+        ++out.c.triangle_pairs;
+        if constexpr (kFilter == TriangleFilter::Swept) {
           if (near != nullptr) *near = !(ap.bound_t1[sa] > plan.near_distance);
           if (ap.apart[sa]) {
             ++out.c.faces_apart;
             continue;
           }
-          break;
-        case TriangleFilter::Static:
+        } else if constexpr (kFilter == TriangleFilter::Static) {
           if (bd.bound[sb] > plan.distance) continue;
-          break;
-        case TriangleFilter::None:
+        } else {
           if (near != nullptr) *near = !(bd.bound[sb] > plan.near_distance);
-          break;
+        }
+        features(piece[k].first, piece[k].second, out);
       }
-      features(piece[k].first, piece[k].second, out);
-    }
-  };
-  const std::vector<PairList::Piece> pieces = pairs.pieces(kPiece);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces.size(), 1),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      Local& out = locals.local();
-                      for (std::size_t p = r.begin(); p != r.end(); ++p) {
-                        const std::span<const FacePair> piece = pieces[p].pairs;
-                        for (std::size_t k0 = 0; k0 < piece.size(); k0 += kBatch) {
-                          chunk(pieces[p].first, piece, k0, std::min(piece.size(), k0 + kBatch),
-                                out);
+    };
+    const std::vector<PairList::Piece> pieces = pairs.pieces(kPiece);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces.size(), 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        Local& out = locals.local();
+                        for (std::size_t p = r.begin(); p != r.end(); ++p) {
+                          const std::span<const FacePair> piece = pieces[p].pairs;
+                          for (std::size_t k0 = 0; k0 < piece.size(); k0 += kBatch) {
+                            chunk(pieces[p].first, piece, k0, std::min(piece.size(), k0 + kBatch),
+                                  out);
+                          }
                         }
-                      }
-                    });
+                      });
+  };
+  switch (plan.filter) {
+    case TriangleFilter::None:
+      run.template operator()<TriangleFilter::None>();
+      break;
+    case TriangleFilter::Swept:
+      run.template operator()<TriangleFilter::Swept>();
+      break;
+    case TriangleFilter::Static:
+      run.template operator()<TriangleFilter::Static>();
+      break;
+  }
 }
 
 }  // namespace clothcd::detail
