@@ -259,7 +259,9 @@ TEST(StrainLimiter, LimitedRunStaysCrossingFreeAndWithinTheLimit) {
     EXPECT_EQ(f.self_intersections, 0) << "frame " << f.frame;
     EXPECT_EQ(f.body_intersections, 0) << "frame " << f.frame;
     EXPECT_EQ(f.collision.unresolved, 0) << "frame " << f.frame;
-    if (f.frame <= 5) EXPECT_LT(f.strain.p99, 0.05 + 1e-3) << "frame " << f.frame;
+    if (f.frame <= 5) {
+      EXPECT_LT(f.strain.p99, 0.05 + 1e-3) << "frame " << f.frame;
+    }
   }
 }
 
