@@ -63,6 +63,14 @@ template <class Vec>
   return clearance - kClearanceRounding * scale;
 }
 
+/// A triangle's smallest height: twice its area over its longest side (NaN with no extent).
+[[nodiscard]] inline double triangle_smallest_height(
+    const std::array<const Eigen::Vector3d*, 3>& x) {
+  const Eigen::Vector3d ab = *x[1] - *x[0], ac = *x[2] - *x[0], bc = *x[2] - *x[1];
+  const double longest2 = std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
+  return ab.cross(ac).norm() / std::sqrt(longest2);
+}
+
 /// A lower bound on triangle_corner_clearance(x0, x1), below it by at least its rounding, in
 /// fewer operations: every corner's distance to its opposite side is at least the triangle's
 /// smallest height (twice its area over its longest side) at each end of the step, and every
@@ -72,18 +80,13 @@ template <class Vec>
 [[nodiscard]] inline double triangle_corner_clearance_bound(
     const std::array<const Eigen::Vector3d*, 3>& x0,
     const std::array<const Eigen::Vector3d*, 3>& x1) {
-  auto smallest_height = [](const std::array<const Eigen::Vector3d*, 3>& x) {
-    const Eigen::Vector3d ab = *x[1] - *x[0], ac = *x[2] - *x[0], bc = *x[2] - *x[1];
-    const double longest2 = std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
-    return ab.cross(ac).norm() / std::sqrt(longest2);
-  };
   double rate2 = 0, scale = 0;
   for (int i = 0; i < 3; ++i) {
     const int j = (i + 1) % 3;
     rate2 = std::max(rate2, ((*x1[j] - *x0[j]) - (*x1[i] - *x0[i])).squaredNorm());
     scale = std::max({scale, x0[i]->lpNorm<Eigen::Infinity>(), x1[i]->lpNorm<Eigen::Infinity>()});
   }
-  return 0.5 * (smallest_height(x0) + smallest_height(x1) - std::sqrt(rate2)) -
+  return 0.5 * (triangle_smallest_height(x0) + triangle_smallest_height(x1) - std::sqrt(rate2)) -
          2 * kClearanceRounding * scale;
 }
 
@@ -95,11 +98,6 @@ struct CornerBounds {
 [[nodiscard]] inline CornerBounds triangle_corner_clearance_bounds(
     const std::array<const Eigen::Vector3d*, 3>& x0,
     const std::array<const Eigen::Vector3d*, 3>& x1) {
-  auto smallest_height = [](const std::array<const Eigen::Vector3d*, 3>& x) {
-    const Eigen::Vector3d ab = *x[1] - *x[0], ac = *x[2] - *x[0], bc = *x[2] - *x[1];
-    const double longest2 = std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
-    return ab.cross(ac).norm() / std::sqrt(longest2);
-  };
   double rate2 = 0, scale = 0, scale1 = 0;
   for (int i = 0; i < 3; ++i) {
     const int j = (i + 1) % 3;
@@ -108,9 +106,10 @@ struct CornerBounds {
     scale = std::max({scale, x0[i]->lpNorm<Eigen::Infinity>(), s1});
     scale1 = std::max(scale1, s1);
   }
-  const double h1 = smallest_height(x1);
-  return {0.5 * (smallest_height(x0) + h1 - std::sqrt(rate2)) - 2 * kClearanceRounding * scale,
-          h1 - 2 * kClearanceRounding * scale1};  // 0.5 * (h1 + h1 - 0), exactly
+  const double h1 = triangle_smallest_height(x1);
+  return {
+      0.5 * (triangle_smallest_height(x0) + h1 - std::sqrt(rate2)) - 2 * kClearanceRounding * scale,
+      h1 - 2 * kClearanceRounding * scale1};  // 0.5 * (h1 + h1 - 0), exactly
 }
 
 /// True when, projected along the unit `axis`, every vertex of the contour loop stays farther than

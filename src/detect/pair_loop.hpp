@@ -80,10 +80,10 @@ void pair_loop(const PairList& pairs, const LoopSide& a, const LoopSide& b, cons
                            std::size_t k1, Local& out) {
       FacesApartBatch& ap = out.apart;
       FaceBoundBatch& bd = out.bound;
-      std::array<bool, kBatch> past{};
+      std::array<bool, kBatch> past;  // set for every pair of the chunk before it is read
       for (std::size_t k = k0; k < k1; ++k) {
-        // Written here, not in a helper: a function of prefetches alone counts as free of side
-        // effects, and the compiler drops its calls.
+        // In the loop body itself: to the compiler a call of a function that only prefetches
+        // has no effect, and it deletes the call.
         if (k + kFar < piece.size()) fetch(piece[k + kFar].first, piece[k + kFar].second);
         const auto [f, g] = piece[k];
         const std::size_t s = k - k0;

@@ -213,26 +213,24 @@ struct SelfCore : MeshState {
                     KernelEe&& kee) const {
     const auto& faces = topo.faces();
     const auto& edges = topo.edges();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.vf.size(), 256),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        auto& out = locals.local();
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          const auto [v, f] = orphans.vf[i];
-                          if (!vf_in_scope(scope, v, f)) continue;
-                          if (!overlap(ctx.vertex_box(v), ctx.face_box(f))) continue;
-                          kvf(v, f, faces[f], out);
-                        }
-                      });
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, orphans.ee.size(), 256),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        auto& out = locals.local();
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          const auto [ea, eb] = orphans.ee[i];
-                          if (!ee_in_scope(scope, ea, eb)) continue;
-                          if (!overlap(ctx.edge_box(ea), ctx.edge_box(eb))) continue;
-                          kee(ea, eb, edges[ea], edges[eb], out);
-                        }
-                      });
+    const auto each = [&](const std::vector<std::pair<int, int>>& list, auto&& test) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, list.size(), 256),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          auto& out = locals.local();
+                          for (std::size_t i = r.begin(); i != r.end(); ++i)
+                            test(list[i].first, list[i].second, out);
+                        });
+    };
+    each(orphans.vf, [&](int v, int f, auto& out) {
+      if (vf_in_scope(scope, v, f) && overlap(ctx.vertex_box(v), ctx.face_box(f))) {
+        kvf(v, f, faces[f], out);
+      }
+    });
+    each(orphans.ee, [&](int ea, int eb, auto& out) {
+      if (ee_in_scope(scope, ea, eb) && overlap(ctx.edge_box(ea), ctx.edge_box(eb))) {
+        kee(ea, eb, edges[ea], edges[eb], out);
+      }
+    });
   }
   // Adds the buffers' counters and collisions to `res` (left unsorted).
   static void gather(const NarrowLocals& locals, DetectResult& res);
@@ -256,9 +254,9 @@ struct SelfCore : MeshState {
   [[nodiscard]] LoopSide loop_side(const FeatureContext& ctx) const {
     return {ctx.v0, ctx.v1, &topo.faces(), ctx.face_boxes, ctx.fboxes};
   }
-  // The pair loop's prefetch of faces f's and g's ownership records and box blocks. Inlined
-  // always: a function of prefetches alone counts as free of side effects, and its calls would
-  // be dropped.
+  // The pair loop's prefetch of faces f's and g's ownership records and box blocks. Always
+  // inlined: to the compiler a call of a function that only prefetches has no effect, and it
+  // deletes the call.
   [[nodiscard]] auto fetch(const FeatureContext& ctx) const {
     return [ this, &ctx ](int f, int g) __attribute__((always_inline)) {
       for (int h : {f, g}) {

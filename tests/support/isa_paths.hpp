@@ -2,7 +2,7 @@
 // The vectorised bodies that a test compares with the scalar one: which of them this processor
 // ran and which it lacks, said in the test's output (once per body and path in a process) and
 // recorded as properties of the test, so that a run on a machine without AVX-512 shows what it
-// left untested instead of passing silently.
+// left untested.
 
 #include <gtest/gtest.h>
 
