@@ -78,7 +78,7 @@ void add_stats(const DetectStats& w, DetectStats& s) {
 EarliestImpact SelfCore::earliest_impact(PointsIn p0, PointsIn p1, const EarliestOptions& eo) {
   check_earliest_options(eo);
   const int nv = topo.num_vertices();
-  std::vector<Eigen::Vector3d> x0, x1, xt;
+  std::vector<Eigen::Vector3d> x0, x1, xs, xt;
   to_points(p0, nv, "positions at t0", x0);
   to_points(p1, nv, "positions at t1", x1);
   update_links();
@@ -110,19 +110,23 @@ EarliestImpact SelfCore::earliest_impact(PointsIn p0, PointsIn p1, const Earlies
       core.cull = rule;
     }
   } restore{*this, saved, saved_rule};
-  return search_windows(
-      first, rounding_slack(x0, x1), search, [&](double t, double slack, DetectStats& stats) {
-        opt = window_options(saved, slack, search.kernel().toi_tolerance);
-        // A short window's boxes are small: cones would cost a refit of their own and cull
-        // little, so its traversal tests boxes only. Its filters pick its hits, which the step's
-        // kernels time; the step's own hits come with their coarse times.
-        cull = t < 1 ? Rule::None : saved_rule;
-        if (t < 1) interpolate(x0, x1, t, xt);
-        const DetectResult r = detect(std::span<const Eigen::Vector3d>(x0),
-                                      std::span<const Eigen::Vector3d>(t < 1 ? xt : x1), t == 1);
-        add_stats(r.stats, stats);
-        search.add(r.vf, r.ee, t, false);
-      });
+  return search_windows(first, rounding_slack(x0, x1), search,
+                        [&](double lo, double hi, double slack, DetectStats& stats) {
+                          const bool whole = lo == 0 && hi == 1;
+                          opt = window_options(saved, slack, search.kernel().toi_tolerance);
+                          // A short window's boxes are small: cones would cost a refit of their own
+                          // and cull little, so its traversal tests boxes only. Its filters pick
+                          // its hits, which the step's kernels time; the whole step's hits come
+                          // with their coarse times.
+                          cull = whole ? saved_rule : Rule::None;
+                          if (lo > 0) interpolate(x0, x1, lo, xs);
+                          if (hi < 1) interpolate(x0, x1, hi, xt);
+                          const DetectResult r =
+                              detect(std::span<const Eigen::Vector3d>(lo > 0 ? xs : x0),
+                                     std::span<const Eigen::Vector3d>(hi < 1 ? xt : x1), whole);
+                          add_stats(r.stats, stats);
+                          search.add(r.vf, r.ee, false);
+                        });
 }
 
 }  // namespace clothcd::detail

@@ -1,23 +1,26 @@
 #pragma once
-// The earliest-impact query of both detectors, as detections over time windows. A window [0, T]
-// is the sub-step x0 -> x(T) = x0 + T (x1 - x0), run through the detector's own pipeline (boxes,
-// traversal, filters; FilterPlan::kernel) at the thickness plus an allowance for the
-// rounding of x(T): its boxes and filters see only the motion up to T, so a short window holds
-// few candidate pairs and filters away almost all of them. Its hits, the pairs the filters keep,
-// may touch by T; the step's own kernels time them (over the whole step, as detect() would), and
-// a time by T is a contact of the window. Only a window without one leads to the next, [0, 1] (the
-// step itself). The earliest times are then refined to the query's tolerance (EarliestSearch).
+// The earliest-impact query of both detectors, as detections over time windows. A window
+// [lo, hi] is the sub-step x(lo) -> x(hi), x(t) = x0 + t (x1 - x0), run through the detector's
+// own pipeline (boxes, traversal, filters; FilterPlan::kernel) at the thickness plus an
+// allowance for the rounding of x(t): its boxes and filters see only the motion over
+// [lo, hi], so a short window holds few candidate pairs and filters away almost all of them. Its
+// hits, the pairs the filters keep, may touch in it; the step's own kernels time them (over the
+// whole step, as detect() would), and a time by hi is a contact of the window. Only a window
+// without one leads to the next, longer one (search_windows). The earliest times are then refined
+// to the query's tolerance (EarliestSearch).
 //
-// Why a window answers for the step: every pair that comes within h before T comes, in the
+// Why a window answers for the step: every pair that comes within h in [lo, hi] comes, in the
 // computed sub-step, within h plus the allowance (each interpolated position lies within
 // `rounding_slack` / 2 of the exact one), so the window reports it, and the step's kernels give
-// it a time no later than its contact. Every time is a function of its pair alone, so the
-// minimum, with ties broken by (kind, ids), does not depend on the thread count.
+// it a time no later than its contact; the earlier windows held no contact. The hits are timed
+// in an order and in batches fixed by the hits alone, and ties go to the smallest (kind, ids),
+// so the answer does not depend on the thread count.
 
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <cfloat>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -29,6 +32,7 @@
 #include <tbb/parallel_for.h>
 
 #include "ccd/batch.hpp"
+#include "clothcd/ccd/proximity.hpp"
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/detect/detector.hpp"
 #include "clothcd/mesh/topology.hpp"
@@ -99,54 +103,56 @@ class EarliestSearch {
                  MakeEe make_ee)
       : kernel_(step_kernel), tolerance_(toi_tolerance), make_vf_(make_vf), make_ee_(make_ee) {
     kernel_.toi_tolerance = std::max(toi_tolerance, kCoarseToiTolerance);
+    fine_ = kernel_;
+    fine_.toi_tolerance = tolerance_;
   }
 
-  /// The hits of window [0, t] (a window's detection with the settings of `window_options`:
-  /// their times are its own); with t = 1 the step's, already timed by the step's kernels.
-  void add(std::span<const VertexFaceCollision> vf, std::span<const EdgeEdgeCollision> ee, double t,
+  /// Adds the hits of a window's detection (with the settings of `window_options`; for the
+  /// whole step in one window, a detection with kernels, whose times are the kernels' own).
+  void add(std::span<const VertexFaceCollision> vf, std::span<const EdgeEdgeCollision> ee,
            bool vertex_on_b) {
     using Kind = EarliestImpact::Kind;
-    const std::size_t first = hits_.size();
     for (const VertexFaceCollision& c : vf)
       hits_.push_back({c.toi, Kind::VertexFace, vertex_on_b, {c.vertex, c.face}});
     for (const EdgeEdgeCollision& c : ee)
       hits_.push_back({c.toi, Kind::EdgeEdge, false, {c.edge_a, c.edge_b}});
-    if (t == 1.0) return;
-    // A window's hit is a pair that may touch by t; the step's kernels time it, and only a time
-    // by t counts (every pair touching by t has one: the kernels are never late).
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(first, hits_.size(), 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                          Hit& h = hits_[i];
-                          const CcdResult k = h.kind == Kind::VertexFace
-                                                  ? vertex_face_ccd(query_vf(h), kernel_)
-                                                  : edge_edge_ccd(query_ee(h), kernel_);
-                          h.toi = k.hit && k.toi <= t ? k.toi : 2.0;
-                        }
-                      });
-    std::erase_if(hits_, [](const Hit& h) { return h.toi > 1.0; });
   }
 
-  /// The earliest hit, its time refined to the query's tolerance (None when there is no hit);
-  /// forgets the hits. A refined time is never earlier than the coarse one, so the hits are
-  /// refined in the order of their coarse times until one comes after the best so far.
-  [[nodiscard]] EarliestImpact take_earliest() {
-    std::sort(hits_.begin(), hits_.end(), [](const Hit& x, const Hit& y) {
-      return std::tuple(x.toi, x.kind, x.vertex_on_b, x.ids) <
-             std::tuple(y.toi, y.kind, y.vertex_on_b, y.ids);
-    });
-    CcdOptions fine = kernel_;
-    fine.toi_tolerance = tolerance_;
+  /// The earliest of the hits added, its time refined to the query's tolerance, among the times
+  /// by `hi` (None when there is none); forgets the hits. `timed`: the hits carry the kernels'
+  /// times (the whole step in one window); otherwise they are a window's candidates, and the
+  /// step's kernels time them here (over the whole step: every pair touching by hi gets a time
+  /// by hi, the kernels are never late).
+  ///
+  /// Untimed hits go in order of a lower bound on when they can touch, in batches of growing
+  /// size; the kernels of a batch run in parallel, each pair first asking whether it can touch
+  /// before the best refined time of the earlier batches (one existence query), so that once a
+  /// small time is known the other pairs cost little. A pair that cannot touch by then never
+  /// comes first. The batches depend on the hits alone, so the answer does not depend on the
+  /// thread count.
+  [[nodiscard]] EarliestImpact take_earliest(double hi, bool timed) {
     EarliestImpact best;
-    for (const Hit& h : hits_) {
-      EarliestImpact e;
-      e.toi = h.toi;
-      e.kind = h.kind;
-      e.ids = h.ids;
-      e.vertex_on_b = h.vertex_on_b;
-      if (!(earliest_key(e) < earliest_key(best))) break;
-      if (tolerance_ < kernel_.toi_tolerance) e.toi = refine(h, fine, best.toi);
-      if (earliest_key(e) < earliest_key(best)) best = e;
+    if (timed) {
+      best = refine_earliest(hits_.begin(), hits_.end(), best);
+      hits_.clear();
+      return best;
+    }
+    order_by_reach();
+    std::size_t size = kFirstBatch;
+    for (std::size_t first = 0; first < hits_.size();
+         first += size, size = std::min(2 * size, kLastBatch)) {
+      const std::size_t last = std::min(hits_.size(), first + size);
+      const double cap = std::min(hi, best.toi);
+      const bool known = best.kind != EarliestImpact::Kind::None;
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(first, last, 8),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i)
+                            hits_[i].toi = coarse_time(hits_[i], cap, known ? &best : nullptr);
+                        });
+      const auto batch_end = std::partition(hits_.begin() + static_cast<std::ptrdiff_t>(first),
+                                            hits_.begin() + static_cast<std::ptrdiff_t>(last),
+                                            [](const Hit& h) { return h.toi <= 1.0; });
+      best = refine_earliest(hits_.begin() + static_cast<std::ptrdiff_t>(first), batch_end, best);
     }
     hits_.clear();
     return best;
@@ -162,60 +168,157 @@ class EarliestSearch {
     bool vertex_on_b;
     std::array<int, 2> ids;
   };
+  // The first batch is small, so that a first time is known early; later ones are larger, so
+  // that their parallel loops stay worth starting.
+  static constexpr std::size_t kFirstBatch = 16;
+  static constexpr std::size_t kLastBatch = 1024;
+
+  // Orders the hits by a lower bound on their first contact: the distance at t0 beyond the
+  // thickness over the largest relative displacement of their points (an order only: the times
+  // come from the kernels), ties by (kind, side, ids).
+  void order_by_reach() {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hits_.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i)
+                          hits_[i].toi = reach_time(hits_[i]);
+                      });
+    std::sort(hits_.begin(), hits_.end(),
+              [](const Hit& x, const Hit& y) { return key(x) < key(y); });
+  }
+  [[nodiscard]] double reach_time(const Hit& h) const {
+    double d = 0, moved = 0;
+    if (h.kind == EarliestImpact::Kind::VertexFace) {
+      const VertexFaceQuery q = query_vf(h);
+      d = point_triangle_proximity(q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0).distance;
+      const Eigen::Vector3d dv = q.v_t1 - q.v_t0;
+      for (const auto& [a, b] :
+           {std::pair{&q.f0_t0, &q.f0_t1}, {&q.f1_t0, &q.f1_t1}, {&q.f2_t0, &q.f2_t1}})
+        moved = std::max(moved, (dv - (*b - *a)).norm());
+    } else {
+      const EdgeEdgeQuery q = query_ee(h);
+      d = edge_edge_proximity(q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0).distance;
+      for (const auto& [a, b] : {std::pair{&q.ea0_t0, &q.ea0_t1}, {&q.ea1_t0, &q.ea1_t1}})
+        for (const auto& [c, e] : {std::pair{&q.eb0_t0, &q.eb0_t1}, {&q.eb1_t0, &q.eb1_t1}})
+          moved = std::max(moved, ((*b - *a) - (*e - *c)).norm());
+    }
+    const double gap = std::max(0.0, d - kernel_.thickness);
+    return gap == 0 ? 0.0 : moved > 0 ? gap / moved : INFINITY;
+  }
+  [[nodiscard]] static auto key(const Hit& h) {
+    return std::tuple(h.toi, h.kind, h.vertex_on_b, h.ids);
+  }
+
+  // A window's hit timed by the step's kernel at the coarse tolerance: its time if by `cap`,
+  // otherwise 2. Where the best refined time so far is known (`best`, at most cap), a pair that
+  // cannot come before it is dropped: at time 0 every pair of a larger (kind, ids) (no time is
+  // earlier, and ties go to the smaller), otherwise each that cannot touch by cap (one existence
+  // query).
+  [[nodiscard]] double coarse_time(const Hit& h, double cap, const EarliestImpact* best) const {
+    if (best != nullptr && best->toi == 0 &&
+        std::tuple(h.kind, h.vertex_on_b, h.ids) >
+            std::tuple(best->kind, best->vertex_on_b, best->ids)) {
+      return 2.0;
+    }
+    const auto one = [&](const auto& q) {
+      if (best != nullptr && !ccd_detail::may_touch(q, kernel_, 0.0, cap)) return 2.0;
+      CcdResult k;
+      if constexpr (std::is_same_v<std::decay_t<decltype(q)>, VertexFaceQuery>) {
+        k = vertex_face_ccd(q, kernel_);
+      } else {
+        k = edge_edge_ccd(q, kernel_);
+      }
+      return k.hit && k.toi <= cap ? k.toi : 2.0;
+    };
+    return h.kind == EarliestImpact::Kind::VertexFace ? one(query_vf(h)) : one(query_ee(h));
+  }
+
+  // The earliest of [first, last) (coarse times) refined, against `best`. A refined time is
+  // never earlier than the coarse one, so the hits are refined in the order of their coarse
+  // times until one comes after the best so far.
+  template <class It>
+  [[nodiscard]] EarliestImpact refine_earliest(It first, It last, EarliestImpact best) const {
+    std::sort(first, last, [](const Hit& x, const Hit& y) { return key(x) < key(y); });
+    for (It it = first; it != last; ++it) {
+      const Hit& h = *it;
+      EarliestImpact e;
+      e.toi = h.toi;
+      e.kind = h.kind;
+      e.ids = h.ids;
+      e.vertex_on_b = h.vertex_on_b;
+      if (!(earliest_key(e) < earliest_key(best))) break;
+      if (tolerance_ < kernel_.toi_tolerance) e.toi = refine(h, best.toi);
+      if (earliest_key(e) < earliest_key(best)) best = e;
+    }
+    return best;
+  }
   // A hit's time at the fine tolerance, or `cap` (the best time so far) where it cannot come
   // before it: one existence query over [coarse time, cap] settles most of the hits that lose
   // (a thickness makes many pairs meet at nearly one time). Then at zero thickness the kernel's
   // own fine search, where it is no earlier than the coarse time and within its box budget (the
   // fast path certifies it from the coplanarity cubic, tighter than any box search); otherwise,
   // and where a thickness makes that search run out of boxes, the bisection.
-  [[nodiscard]] double refine(const Hit& h, const CcdOptions& fine, double cap) const {
+  [[nodiscard]] double refine(const Hit& h, double cap) const {
     const auto one = [&](const auto& q) {
-      if (!ccd_detail::may_touch(q, fine, h.toi, cap)) return cap;
-      if (fine.thickness == 0) {
+      if (!ccd_detail::may_touch(q, fine_, h.toi, cap)) return cap;
+      if (fine_.thickness == 0) {
         CcdResult k;
         if constexpr (std::is_same_v<std::decay_t<decltype(q)>, VertexFaceQuery>) {
-          k = vertex_face_ccd(q, fine);
+          k = vertex_face_ccd(q, fine_);
         } else {
-          k = edge_edge_ccd(q, fine);
+          k = edge_edge_ccd(q, fine_);
         }
-        if (settled(k, h, fine)) return std::min(k.toi, cap);
+        if (settled(k, h)) return std::min(k.toi, cap);
       }
-      return std::min(cap, ccd_detail::refine_time_of_impact(q, fine, h.toi, cap));
+      return std::min(cap, ccd_detail::refine_time_of_impact(q, fine_, h.toi, cap));
     };
     return h.kind == EarliestImpact::Kind::VertexFace ? one(query_vf(h)) : one(query_ee(h));
   }
   // Whether the kernel's fine time stands: a hit, no earlier than the coarse time, within its
   // box budget (an exhausted search reports its earliest open time instead).
-  [[nodiscard]] static bool settled(const CcdResult& k, const Hit& h, const CcdOptions& fine) {
-    return k.hit && k.toi >= h.toi && k.boxes < fine.max_boxes;
+  [[nodiscard]] bool settled(const CcdResult& k, const Hit& h) const {
+    return k.hit && k.toi >= h.toi && k.boxes < fine_.max_boxes;
   }
   [[nodiscard]] VertexFaceQuery query_vf(const Hit& h) const {
     return make_vf_(h.ids[0], h.ids[1], h.vertex_on_b);
   }
   [[nodiscard]] EdgeEdgeQuery query_ee(const Hit& h) const { return make_ee_(h.ids[0], h.ids[1]); }
 
-  CcdOptions kernel_;
+  CcdOptions kernel_, fine_;
   double tolerance_;
   MakeVf make_vf_;
   MakeEe make_ee_;
   std::vector<Hit> hits_;
 };
 
-/// The windows' search, shared by the detectors: `detect_window(t, slack, stats)` detects the
-/// window [0, t] (with t = 1 the step itself, slack 0) and adds its hits to `search`. A window
-/// answers when its earliest refined time is within it: every pair touching by t is among its
-/// hits, and no other can come before them.
+/// How much longer each window is than the one before.
+inline constexpr double kWindowGrowth = 4;
+
+/// The windows' search, shared by the detectors: `detect_window(lo, hi, slack, stats)` detects
+/// the window [lo, hi] (the sub-step x(lo) -> x(hi); [0, 1] is the step itself, with slack 0)
+/// and adds its hits to `search`. The windows are [0, first], then each kWindowGrowth times as
+/// long as the one before, up to 1. A window answers when its earliest refined time is by its
+/// end: every pair touching by then touches in it (the earlier windows had none), so it is
+/// among its hits, and no other can come before them.
 template <class Search, class DetectWindow>
 EarliestImpact search_windows(double first, double slack, Search& search,
                               DetectWindow&& detect_window) {
   DetectStats stats;
   int windows = 0;
   EarliestImpact best;
-  for (double t = first;; t = 1.0) {
+  for (double lo = 0, hi = first;; lo = hi, hi = std::min(1.0, hi * kWindowGrowth)) {
     ++windows;
-    detect_window(t, t < 1 ? slack : 0.0, stats);
-    best = search.take_earliest();
-    if ((best.kind != EarliestImpact::Kind::None && best.toi <= t) || t == 1.0) break;
+    // The kernels timing the window's hits and the refinement count as narrow phase, with the
+    // interpolation of the window's positions: the stats give the whole query's time.
+    const auto start = std::chrono::steady_clock::now();
+    const double stages = stats.time_refit + stats.time_traverse + stats.time_narrow;
+    const bool whole = lo == 0 && hi == 1;
+    detect_window(lo, hi, whole ? 0.0 : slack, stats);
+    best = search.take_earliest(hi, whole);
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.time_narrow +=
+        std::max(0.0, took - (stats.time_refit + stats.time_traverse + stats.time_narrow - stages));
+    if ((best.kind != EarliestImpact::Kind::None && best.toi <= hi) || hi == 1.0) break;
   }
   best.windows = windows;
   best.first_window = first;

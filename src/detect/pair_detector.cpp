@@ -268,7 +268,7 @@ struct PairDetector::Impl {
   EarliestImpact earliest_impact(detail::PointsIn pa0, detail::PointsIn pa1, detail::PointsIn pb0,
                                  detail::PointsIn pb1, const EarliestOptions& eo) {
     detail::check_earliest_options(eo);
-    std::vector<Eigen::Vector3d> x[4], at, bt;
+    std::vector<Eigen::Vector3d> x[4], as, at, bs, bt;
     detail::to_points(pa0, a.topo.num_vertices(), "mesh A at t0", x[0]);
     detail::to_points(pa1, a.topo.num_vertices(), "mesh A at t1", x[1]);
     detail::to_points(pb0, b.topo.num_vertices(), "mesh B at t0", x[2]);
@@ -307,17 +307,23 @@ struct PairDetector::Impl {
       ~Restore() { m.opt = saved; }
     } restore{*this, saved};
     return detail::search_windows(
-        first, slack, search, [&](double t, double sl, DetectStats& stats) {
+        first, slack, search, [&](double lo, double hi, double sl, DetectStats& stats) {
+          const bool whole = lo == 0 && hi == 1;
           opt = detail::window_options(saved, sl, search.kernel().toi_tolerance);
-          if (t < 1) {
-            detail::interpolate(x[0], x[1], t, at);
-            detail::interpolate(x[2], x[3], t, bt);
+          if (lo > 0) {
+            detail::interpolate(x[0], x[1], lo, as);
+            detail::interpolate(x[2], x[3], lo, bs);
           }
-          const PairDetectResult r = detect(Points(x[0]), Points(t < 1 ? at : x[1]), Points(x[2]),
-                                            Points(t < 1 ? bt : x[3]), t == 1);
+          if (hi < 1) {
+            detail::interpolate(x[0], x[1], hi, at);
+            detail::interpolate(x[2], x[3], hi, bt);
+          }
+          const PairDetectResult r =
+              detect(Points(lo > 0 ? as : x[0]), Points(hi < 1 ? at : x[1]),
+                     Points(lo > 0 ? bs : x[2]), Points(hi < 1 ? bt : x[3]), whole);
           detail::add_stats(r.stats, stats);
-          search.add(r.vf_a_on_b, r.ee, t, false);
-          search.add(r.vf_b_on_a, {}, t, true);
+          search.add(r.vf_a_on_b, r.ee, false);
+          search.add(r.vf_b_on_a, {}, true);
         });
   }
 

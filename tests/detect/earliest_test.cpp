@@ -6,14 +6,18 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
+#include <string>
 #include <tuple>
+#include <vector>
 
 #include "clothcd/ccd/proximity.hpp"
 #include "clothcd/ccd/queries.hpp"
 #include "clothcd/core/error.hpp"
 #include "clothcd/detect/detector.hpp"
+#include "detect/earliest.hpp"
 #include "exact_oracle.hpp"
 #include "property_scenes.hpp"
 
@@ -36,6 +40,26 @@ EdgeEdgeQuery ee_query(const Positions& a0, const Positions& a1, const Edge& p, 
                        const Positions& b1, const Edge& q) {
   return {a0.row(p[0]), a0.row(p[1]), b0.row(q[0]), b0.row(q[1]),
           a1.row(p[0]), a1.row(p[1]), b1.row(q[0]), b1.row(q[1])};
+}
+
+// The windows searched: [0, first], then each kWindowGrowth times longer up to 1; the search
+// stops at the first that holds the answer, so the one before ends before the reported time
+// (less the kernels' coarse tolerance: a kernel's time may be early by that much).
+void expect_windows(const EarliestImpact& e, const std::string& what) {
+  std::vector<double> ends;
+  for (double hi = e.first_window;; hi = std::min(1.0, hi * detail::kWindowGrowth)) {
+    ends.push_back(hi);
+    if (hi == 1.0) break;
+  }
+  ASSERT_GE(e.windows, 1) << what;
+  ASSERT_LE(e.windows, static_cast<int>(ends.size())) << what;
+  const auto k = static_cast<std::size_t>(e.windows);
+  if (e.kind == Kind::None) {
+    EXPECT_EQ(k, ends.size()) << what;
+    return;
+  }
+  EXPECT_LE(e.toi, ends[k - 1]) << what;
+  if (k > 1) EXPECT_GT(e.toi, ends[k - 2] - 2 * detail::kCoarseToiTolerance) << what;
 }
 
 // The earliest kernel hit over every pair that `keep` admits, ties by (kind, ids), as the query
@@ -155,8 +179,7 @@ TEST(EarliestImpact, RandomScenesMatchBruteForceAndTheExactOracle) {
         if (h == 0 && window == 0 && seed <= 4) {
           expect_no_contact_before(det.topology(), s.v0, s.v1, e.toi);
         }
-        EXPECT_GE(e.windows, 1);
-        EXPECT_LE(e.windows, 2);
+        expect_windows(e, what + " window " + std::to_string(window));
       }
       hits += ref.kind != Kind::None;
     }
@@ -180,6 +203,56 @@ TEST(EarliestImpact, SameAnswerForEveryThreadCount) {
       EXPECT_EQ(e.kind, first->kind);
       EXPECT_EQ(e.ids, first->ids);
     }
+  }
+}
+
+// Two square sheets of n x n cells, the upper one `gap` above the lower one at t0 and both
+// moving: with gap < h, hundreds of VF and EE pairs are within h from the start.
+struct Sheets {
+  std::vector<Face> faces;
+  Positions x0, x1;
+  Sheets(int n, double gap) {
+    const int per = (n + 1) * (n + 1);
+    x0.resize(2 * per, 3);
+    for (int s = 0; s < 2; ++s) {
+      for (int i = 0; i <= n; ++i) {
+        for (int j = 0; j <= n; ++j) {
+          // The upper sheet shifted by a third of a cell, so that its vertices sit over faces.
+          const double shift = s == 0 ? 0.0 : 1.0 / 3;
+          x0.row(s * per + i * (n + 1) + j) << (i + shift) / n, (j + shift) / n, s * gap;
+        }
+      }
+      for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+          const int a = s * per + i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
+          faces.push_back({a, b, d});
+          faces.push_back({a, d, c});
+        }
+      }
+    }
+    x1 = x0;
+    for (int v = 0; v < 2 * per; ++v)
+      x1(v, 2) += v < per ? 0.1 : -0.3;
+  }
+};
+
+// Many pairs within the thickness at t0: the answer is time 0 and, of those pairs, the one of
+// smallest (kind, ids), as brute force has it, on every thread count.
+TEST(EarliestImpact, ManyContactsAtTheStartGiveTheSmallestPair) {
+  const double h = 0x1p-6;
+  const Sheets s(12, h / 2);
+  DetectOptions o;
+  o.thickness = h;
+  SelfDetector det(s.faces, static_cast<int>(s.x0.rows()), s.x0, o);
+  const EarliestImpact ref = brute_self(det.topology(), s.x0, s.x1, kernel_options(h, 1e-6));
+  ASSERT_EQ(ref.toi, 0.0);
+  for (const int threads : {1, 2, 4}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    const EarliestImpact e = det.earliest_impact(s.x0, s.x1);
+    EXPECT_EQ(e.toi, 0.0) << threads << " threads";
+    EXPECT_EQ(e.kind, ref.kind) << threads << " threads";
+    EXPECT_EQ(e.ids, ref.ids) << threads << " threads";
+    EXPECT_EQ(e.windows, 1);
   }
 }
 

@@ -244,9 +244,23 @@ TEST(CliDetect, EarliestWritesTheQuerysAnswer) {
       EXPECT_TRUE(j["stats"].contains(key)) << key;
     EXPECT_EQ(j.size(), 2u) << "earliest, stats";
   }
+  // --repeat N: N more calls on the same detector, their times listed; the answer is the same.
+  {
+    const auto r = dir.run("detect --t0 t0.obj --t1 t1.obj --earliest --repeat 2 --json rep.json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto j = nlohmann::json::parse(CliScratch::slurp(dir / "rep.json"));
+    const EarliestImpact want = det.earliest_impact(vertices_matrix(m0), vertices_matrix(m1));
+    EXPECT_EQ(j["earliest"]["toi"].get<double>(), want.toi);
+    ASSERT_EQ(j["repeat"].size(), 2u);
+    for (const auto& call : j["repeat"]) {
+      for (const char* key : {"time_refit", "time_traverse", "time_narrow"})
+        EXPECT_GE(call[key].get<double>(), 0.0) << key;
+    }
+  }
   // Settings it cannot honour: an error, and no output file.
-  for (const char* bad : {"--earliest --first-window 0.3", "--earliest --table",
-                          "--first-window 0.5", "--earliest --toi-tolerance 0"}) {
+  for (const char* bad :
+       {"--earliest --first-window 0.3", "--earliest --table", "--first-window 0.5",
+        "--earliest --toi-tolerance 0", "--repeat 2", "--earliest --repeat -1"}) {
     const auto r =
         dir.run(std::string("detect --t0 t0.obj --t1 t1.obj ") + bad + " --json bad.json");
     EXPECT_NE(r.code, 0) << bad;

@@ -92,9 +92,9 @@ class SelfDetector {
   /// How far along the linear motion v_t0 -> v_t1 every VF and EE pair stays farther apart than
   /// the thickness: the earliest time of impact, and the pair (EarliestImpact gives the
   /// guarantee). The pairs are the ones detect() tests (less linked pairs, within the active
-  /// restriction), through detect()'s pipeline: the earliest hit of a detection over a short
-  /// window [0, T] first, of the whole step only where that window holds none (docs/detect.md
-  /// "Earliest impact"). Does not depend on the thread count. Leaves what detect() keeps for later
+  /// restriction), through detect()'s pipeline over time windows: a short window [0, T] first,
+  /// then each next one four times as long, until one holds a contact (docs/detect.md "Earliest
+  /// impact"). Does not depend on the thread count. Leaves what detect() keeps for later
   /// calls (DetectOptions::reuse_distance, reuse_front) as it was. Throws InputError for bad
   /// positions or options.
   [[nodiscard]] EarliestImpact earliest_impact(const Positions& v_t0, const Positions& v_t1,

@@ -126,9 +126,9 @@ struct EarliestOptions {
   double toi_tolerance = 1e-6;
   /// The first time window searched, [0, first_window] (a power of two in (0, 1]); 0 picks it
   /// from the motion: the largest window in which no vertex moves farther than 1/64 of the
-  /// mesh's mean edge length. Only a window that holds no contact leads to the next one, [0, 1].
-  /// Results never depend on the thread count; they may differ between windows by at most the
-  /// tolerance above.
+  /// mesh's mean edge length. Only a window that holds no contact leads to the next one, which
+  /// starts where it ended and is four times as long (the last ends at 1). Results never depend
+  /// on the thread count; they may differ between first windows by at most the tolerance above.
   double first_window = 0;
   bool operator==(const EarliestOptions&) const = default;
 };
@@ -149,12 +149,13 @@ struct EarliestImpact {
   std::array<int, 2> ids{-1, -1};
   /// Between two meshes (PairDetector), for VertexFace: the vertex is B's and the face A's.
   bool vertex_on_b = false;
-  /// Time windows searched: 1 ([0, first_window] held the answer, or was the whole step), or 2
-  /// (then [0, 1]).
+  /// Time windows searched: [0, first_window], then [first_window, 4 first_window], ... up to
+  /// the one that held the answer (or ended at 1).
   int windows = 0;
   double first_window = 1;
   /// Summed over the windows; the collision counts are the windows' hits (in a short window,
-  /// the pairs its filters keep).
+  /// the pairs its filters keep). time_narrow includes the timing and refinement of the hits,
+  /// so the three times add up to the whole query.
   DetectStats stats;
 };
 
