@@ -43,7 +43,7 @@ double first_window(const EarliestOptions& options, std::span<const Topology* co
       moved = std::max(moved, (x1[m][i] - x0[m][i]).norm());
   }
   if (count == 0 || moved == 0) return 1.0;
-  const double reach = edges / count / 64;
+  const double reach = edges / count / kFirstWindowShare;
   double t = 1.0;
   while (t > 0x1p-30 && t * moved > reach)
     t *= 0.5;

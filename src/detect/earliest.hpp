@@ -42,8 +42,15 @@ namespace clothcd::detail {
 /// Refuses settings the query cannot honour (InputError).
 void check_earliest_options(const EarliestOptions& o);
 
+/// The automatic first window's reach: no vertex moves more than this share of the mean edge
+/// length in it. A window costs at least what the boxes overlapping at rest cost, and little
+/// more as it grows to a few edge lengths' motion: a quarter of an edge holds the first contact
+/// of most steps measured (docs/results/earliest.md) at a few percent over the shortest windows.
+inline constexpr double kFirstWindowShare = 4;
+
 /// The first window: options.first_window, or (0) the largest power of two T <= 1 with
-/// T * (largest displacement) <= (mean edge length) / 64 over the meshes given, at least 2^-30.
+/// T * (largest displacement) <= (mean edge length) / kFirstWindowShare over the meshes given,
+/// at least 2^-30.
 [[nodiscard]] double first_window(const EarliestOptions& options,
                                   std::span<const Topology* const> meshes,
                                   std::span<const std::span<const Eigen::Vector3d>> x0,

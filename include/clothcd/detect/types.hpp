@@ -125,7 +125,7 @@ struct EarliestOptions {
   /// the winning pair's time of impact to this.
   double toi_tolerance = 1e-6;
   /// The first time window searched, [0, first_window] (a power of two in (0, 1]); 0 picks it
-  /// from the motion: the largest window in which no vertex moves farther than 1/64 of the
+  /// from the motion: the largest window in which no vertex moves farther than a quarter of the
   /// mesh's mean edge length. Only a window that holds no contact leads to the next one, which
   /// starts where it ended and is four times as long (the last ends at 1). Results never depend
   /// on the thread count; they may differ between first windows by at most the tolerance above.
