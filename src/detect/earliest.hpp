@@ -174,42 +174,56 @@ class EarliestSearch {
     EarliestImpact::Kind kind;
     bool vertex_on_b;
     std::array<int, 2> ids;
+    // For a window's hits: a lower bound on the features' distance at t0, and the largest
+    // relative displacement of their points over the step (reach()).
+    double gap = 0, speed = 0;
   };
   // The first batch is small, so that a first time is known early; later ones are larger, so
   // that their parallel loops stay worth starting.
   static constexpr std::size_t kFirstBatch = 16;
   static constexpr std::size_t kLastBatch = 1024;
 
-  // Orders the hits by a lower bound on their first contact: the distance at t0 beyond the
-  // thickness over the largest relative displacement of their points (an order only: the times
-  // come from the kernels), ties by (kind, side, ids).
+  // Orders the hits by when they could first touch: the distance at t0 beyond the thickness
+  // over the largest relative displacement of their points (an order only: the times come from
+  // the kernels), ties by (kind, side, ids). Keeps each hit's bounds for can_touch().
   void order_by_reach() {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, hits_.size(), 64),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         for (std::size_t i = r.begin(); i != r.end(); ++i)
-                          hits_[i].toi = reach_time(hits_[i]);
+                          reach(hits_[i]);
                       });
     std::sort(hits_.begin(), hits_.end(),
               [](const Hit& x, const Hit& y) { return key(x) < key(y); });
   }
-  [[nodiscard]] double reach_time(const Hit& h) const {
-    double d = 0, moved = 0;
+  // Over the step the distance of two features falls by at most t times the largest relative
+  // displacement of their points (the closest points are convex combinations of them).
+  void reach(Hit& h) const {
+    double d = 0;
+    h.speed = 0;
     if (h.kind == EarliestImpact::Kind::VertexFace) {
       const VertexFaceQuery q = query_vf(h);
       d = point_triangle_proximity(q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0).distance;
+      h.gap = point_triangle_distance_lower_bound(q.v_t0, q.f0_t0, q.f1_t0, q.f2_t0);
       const Eigen::Vector3d dv = q.v_t1 - q.v_t0;
       for (const auto& [a, b] :
            {std::pair{&q.f0_t0, &q.f0_t1}, {&q.f1_t0, &q.f1_t1}, {&q.f2_t0, &q.f2_t1}})
-        moved = std::max(moved, (dv - (*b - *a)).norm());
+        h.speed = std::max(h.speed, (dv - (*b - *a)).norm());
     } else {
       const EdgeEdgeQuery q = query_ee(h);
       d = edge_edge_proximity(q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0).distance;
+      h.gap = edge_edge_distance_lower_bound(q.ea0_t0, q.ea1_t0, q.eb0_t0, q.eb1_t0);
       for (const auto& [a, b] : {std::pair{&q.ea0_t0, &q.ea0_t1}, {&q.ea1_t0, &q.ea1_t1}})
         for (const auto& [c, e] : {std::pair{&q.eb0_t0, &q.eb0_t1}, {&q.eb1_t0, &q.eb1_t1}})
-          moved = std::max(moved, ((*b - *a) - (*e - *c)).norm());
+          h.speed = std::max(h.speed, ((*b - *a) - (*e - *c)).norm());
     }
     const double gap = std::max(0.0, d - kernel_.thickness);
-    return gap == 0 ? 0.0 : moved > 0 ? gap / moved : INFINITY;
+    h.toi = gap == 0 ? 0.0 : h.speed > 0 ? gap / h.speed : INFINITY;
+  }
+  // Whether the hit's features can come within the thickness by `cap` by reach()'s bound, with
+  // a relative allowance for the rounding of the bounds (the distance's lower bound allows for
+  // its own).
+  [[nodiscard]] bool can_touch(const Hit& h, double cap) const {
+    return h.gap <= (kernel_.thickness + cap * h.speed * (1 + 1e-9)) * (1 + 1e-12);
   }
   [[nodiscard]] static auto key(const Hit& h) {
     return std::tuple(h.toi, h.kind, h.vertex_on_b, h.ids);
@@ -218,14 +232,15 @@ class EarliestSearch {
   // A window's hit timed by the step's kernel at the coarse tolerance: its time if by `cap`,
   // otherwise 2. Where the best refined time so far is known (`best`, at most cap), a pair that
   // cannot come before it is dropped: at time 0 every pair of a larger (kind, ids) (no time is
-  // earlier, and ties go to the smaller), otherwise each that cannot touch by cap (one existence
-  // query).
+  // earlier, and ties go to the smaller), otherwise each that cannot touch by cap, by its
+  // distance and speed (can_touch) or else by one existence query.
   [[nodiscard]] double coarse_time(const Hit& h, double cap, const EarliestImpact* best) const {
     if (best != nullptr && best->toi == 0 &&
         std::tuple(h.kind, h.vertex_on_b, h.ids) >
             std::tuple(best->kind, best->vertex_on_b, best->ids)) {
       return 2.0;
     }
+    if (best != nullptr && !can_touch(h, cap)) return 2.0;
     const auto one = [&](const auto& q) {
       if (best != nullptr && !ccd_detail::may_touch(q, kernel_, 0.0, cap)) return 2.0;
       CcdResult k;
