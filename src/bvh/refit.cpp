@@ -58,6 +58,9 @@ void Bvh::refit_levels(const RefitOptions& options, bool optimal_cones,
     if (nodes_[c].count < min_count && (only.empty() || only[c] != 0)) cones_[c] = patch(c);
     return cones_[c];
   };
+  // The cones are allocated by the first refit that fits them (a box-only detector never pays
+  // for them: a 4M-triangle tree's cones take 256 MB).
+  if (options.cones && cones_.size() != nodes_.size()) cones_.resize(nodes_.size());
   if (optimal) {
     control_dirs_.resize(3 * prim_ids_.size());
     degenerate_.resize(prim_ids_.size());

@@ -118,10 +118,10 @@ class Bvh {
   [[nodiscard]] int depth() const { return static_cast<int>(level_offsets_.size()) - 1; }
   /// The oriented boundary loop (vertex ids) of a disk node; empty for other nodes.
   [[nodiscard]] std::span<const int> contour(int node) const;
-  /// Normal cones of the last refit with cones, one per node. A saturated cone (one that bounds
-  /// no half-space) has a half-angle of at least pi/2: pi/2 exactly where a cone function made it
-  /// (kSaturatedHalfAngle), pi for an internal node above a saturated child. Test it with
-  /// NormalCone::saturated(), not by comparing the angle.
+  /// Normal cones of the last refit with cones, one per node (none before the first). A saturated
+  /// cone (one that bounds no half-space) has a half-angle of at least pi/2: pi/2 exactly where a
+  /// cone function made it (kSaturatedHalfAngle), pi for an internal node above a saturated child.
+  /// Test it with NormalCone::saturated(), not by comparing the angle.
   [[nodiscard]] const std::vector<NormalCone>& cones() const { return cones_; }
   /// The faces the tree was built over (its own copy); refits read positions by these ids.
   [[nodiscard]] const std::vector<Face>& faces() const { return faces_; }
