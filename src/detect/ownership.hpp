@@ -48,11 +48,9 @@ class Ownership {
     for_each(topo.num_edges(), [&](int e) {
       const auto fs = topo.edge_faces(e);
       EdgeFaces& r = pair_[e];
-      r.general = fs.size() > 2;
-      for (std::size_t i = 0; i < 2; ++i) {
+      for (std::size_t i = 0; i < 2; ++i)
         r.f[i] = i < fs.size() ? fs[i] : -1;
-        r.t[i] = i < fs.size() ? topo.faces()[fs[i]] : Face{-1, -1, -1};
-      }
+      if (fs.size() > 2) r.f[0] = kGeneral;
     });
     records_.resize(topo.num_faces());
     for_each(topo.num_faces(), [&](int f) {
@@ -120,25 +118,26 @@ class Ownership {
   [[nodiscard]] bool owns_ee(int e1, int e2, int x, int y) const {
     const EdgeFaces& a = pair_[e1];
     const EdgeFaces& b = pair_[e2];
-    if (a.general || b.general) return owns_ee_general(e1, e2, x, y);
+    if (a.f[0] == kGeneral || b.f[0] == kGeneral) return owns_ee_general(e1, e2, x, y);
     // The same search over the copies (at most two faces per edge, in edge_faces order).
+    const auto& faces = topo_->faces();
     for (int i = 0; i < 2 && a.f[i] >= 0; ++i) {
       for (int j = 0; j < 2 && b.f[j] >= 0; ++j) {
         if (a.f[i] == x && b.f[j] == y) return true;
-        if (!share_vertex(a.t[i], b.t[j])) return false;
+        if (!share_vertex(faces[a.f[i]], faces[b.f[j]])) return false;
       }
     }
     return false;
   }
 
  private:
-  // An edge's (first two) faces and their corners side by side: the search touches one record
-  // per edge instead of the offset, id and face arrays.
+  // An edge's first two faces side by side: the search reads one record per edge instead of the
+  // offset and id arrays. Ids only (8 bytes an edge): the corners, read from the faces, would
+  // make it 36, for a search that few feature pairs need.
   struct EdgeFaces {
-    int f[2];  // -1 past the edge's faces
-    Face t[2];
-    bool general;  // more than two faces: use owns_ee_general
+    int f[2];  // -1 past the edge's faces; f[0] == kGeneral: more than two (owns_ee_general)
   };
+  static constexpr int kGeneral = -2;
 
   [[nodiscard]] bool owns_ee_general(int e1, int e2, int x, int y) const {
     const auto& faces = topo_->faces();
