@@ -6,6 +6,16 @@
 
 namespace clothcd::detail {
 
+/// Where FeatureBoxes keeps a step's edge and face boxes.
+enum class BoxStore : std::uint8_t {
+  Separate,  // one array per kind (vertices, edges, faces)
+  Both,      // those arrays and the face blocks (FaceBoxes) that gather them per face
+  // The vertex array and the face blocks only: an edge's and a face's boxes are read from a
+  // block (FeatureContext::edge_box, face_box). The pair loop reads the blocks alone, and the
+  // arrays would take another 60 bytes a face (240 MB on 4M triangles).
+  Blocks,
+};
+
 /// The swept boxes of every vertex, edge and face for one step, kept between steps: `update`
 /// recomputes only the boxes of features with a vertex whose positions (t0 or t1) changed since
 /// the last update with the same margin. A box depends on nothing else, so the result is the same
@@ -16,11 +26,14 @@ class FeatureBoxes {
  public:
   /// `face_blocks`: also keep each face's boxes gathered as a FaceBoxes (FeatureContext::
   /// face_boxes), for the pair loop of owned_feature_pairs.
-  explicit FeatureBoxes(bool face_blocks = false) : blocks_on_(face_blocks) {}
+  explicit FeatureBoxes(bool face_blocks = false)
+      : store_(face_blocks ? BoxStore::Both : BoxStore::Separate) {}
+  explicit FeatureBoxes(BoxStore store) : store_(store) {}
 
-  /// Brings the boxes up to date with ctx's positions and margin and points ctx at them. ctx's
-  /// positions must be `step`'s current ones: when the boxes were last updated at the previous
-  /// call of `step` with the same margin, only the features of its changed vertices are redone.
+  /// Brings the boxes up to date with ctx's positions and margin and points ctx at them (at no
+  /// edge or face array with BoxStore::Blocks). ctx's positions must be `step`'s current ones:
+  /// when the boxes were last updated at the previous call of `step` with the same margin, only
+  /// the features of its changed vertices are redone.
   void update(FeatureContext& ctx, const StepPositions& step) {
     const Topology& topo = *ctx.topo;
     const int nv = topo.num_vertices();
@@ -28,11 +41,14 @@ class FeatureBoxes {
     if (margin_ != ctx.margin) moved = {};  // every box changes: start over
     margin_ = ctx.margin;
     call_ = step.call();
+    const bool arrays = store_ != BoxStore::Blocks, blocks = store_ != BoxStore::Separate;
     if (moved.empty()) {
       vboxes_.resize(nv);
-      eboxes_.resize(topo.num_edges());
-      fboxes_.resize(topo.num_faces());
-      if (blocks_on_) blocks_.resize(topo.num_faces());
+      if (arrays) {
+        eboxes_.resize(topo.num_edges());
+        fboxes_.resize(topo.num_faces());
+      }
+      if (blocks) blocks_.resize(topo.num_faces());
     }
     const auto redo = [&](auto&& ids) {  // a vertex of the feature moved (or all did)
       if (moved.empty()) return true;
@@ -47,32 +63,37 @@ class FeatureBoxes {
     // An edge's or face's box is the union of its vertices' boxes bit for bit: swept_feature_box's
     // rounding (minus the margin, next_down, to float downwards) is monotone, so the rounded
     // minimum of the points is the minimum of their rounded values (likewise upwards).
-    for_each(topo.num_edges(), [&](int e) {
-      if (redo(topo.edges()[e])) eboxes_[e] = merged(topo.edges()[e]);
-    });
-    for_each(topo.num_faces(), [&](int f) {
-      if (redo(topo.faces()[f])) fboxes_[f] = merged(topo.faces()[f]);
-    });
-    if (blocks_on_) {
-      // A face's block holds its own, its edges' and its corners' boxes: copies, redone exactly
-      // when one of those is (a vertex of the face moved).
+    if (arrays) {
+      for_each(topo.num_edges(), [&](int e) {
+        if (redo(topo.edges()[e])) eboxes_[e] = merged(topo.edges()[e]);
+      });
+      for_each(topo.num_faces(), [&](int f) {
+        if (redo(topo.faces()[f])) fboxes_[f] = merged(topo.faces()[f]);
+      });
+    }
+    if (blocks) {
+      // A face's block holds its own, its edges' and its corners' boxes, redone exactly when one
+      // of those is (a vertex of the face moved). Without the arrays, the same merges of the same
+      // vertex boxes in the same order: the same bits.
       for_each(topo.num_faces(), [&](int f) {
         const Face& t = topo.faces()[f];
         if (!redo(t)) return;
         FaceBoxes& b = blocks_[f];
         const auto edges = topo.face_edges(f);
+        const Box face = arrays ? fboxes_[f] : merged(t);
         for (int k = 0; k < 3; ++k) {
-          b.set(FaceBoxes::kEdges + k, eboxes_[edges[k]]);
+          const int e = edges[k];
+          b.set(FaceBoxes::kEdges + k, arrays ? eboxes_[e] : merged(topo.edges()[e]));
           b.set(FaceBoxes::kCorners + k, vboxes_[t[k]]);
         }
-        b.set(FaceBoxes::kFace, fboxes_[f]);
-        b.set(7, fboxes_[f]);
+        b.set(FaceBoxes::kFace, face);
+        b.set(7, face);
       });
       ctx.face_boxes = blocks_;
     }
     ctx.vboxes = vboxes_;
-    ctx.eboxes = eboxes_;
-    ctx.fboxes = fboxes_;
+    ctx.eboxes = arrays ? std::span<const Box>(eboxes_) : std::span<const Box>();
+    ctx.fboxes = arrays ? std::span<const Box>(fboxes_) : std::span<const Box>();
   }
 
  private:
@@ -97,7 +118,7 @@ class FeatureBoxes {
     });
   }
 
-  bool blocks_on_ = false;
+  BoxStore store_ = BoxStore::Separate;
   std::vector<Box> vboxes_, eboxes_, fboxes_;
   std::vector<FaceBoxes> blocks_;
   std::uint64_t call_ = 0;  // the StepPositions call the boxes were computed at (0: none)
