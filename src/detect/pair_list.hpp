@@ -17,15 +17,16 @@ namespace clothcd::detail {
 
 using FacePair = std::pair<int, int>;
 
-/// One thread's pairs, filled in order into blocks: the first of 64 Ki pairs (512 KiB, enough for
-/// a garment-sized step), the others of 512 Ki pairs (4 MiB: large enough for the command-line
-/// tool to put them on huge pages, whose faults are fewer). clear() empties them and keeps their
-/// memory.
-class PairBlocks {
+/// One thread's items, filled in order into blocks: the first of 64 Ki items (512 KiB of pairs,
+/// enough for a garment-sized step), the others of 512 Ki items (4 MiB of pairs: large enough for
+/// the command-line tool to put them on huge pages, whose faults are fewer). clear() empties them
+/// and keeps their memory; drain_into() moves them out and frees it.
+template <class T>
+class Blocks {
  public:
-  void push(int a, int b) {
+  void push_back(const T& x) {
     if (cur_ == nullptr || cur_->size() == cur_->capacity()) next_block();
-    cur_->emplace_back(a, b);
+    cur_->push_back(x);
   }
   void clear() {
     for (std::size_t i = 0; i < used_; ++i)
@@ -39,11 +40,23 @@ class PairBlocks {
       n += blocks_[i].size();
     return n;
   }
-  /// Appends a view of each non-empty block to `out`, in the order the pairs were pushed.
-  void views(std::vector<std::span<const FacePair>>& out) const {
+  /// Appends a view of each non-empty block to `out`, in the order the items were pushed.
+  void views(std::vector<std::span<const T>>& out) const {
     for (std::size_t i = 0; i < used_; ++i) {
       if (!blocks_[i].empty()) out.emplace_back(blocks_[i]);
     }
+  }
+  /// Appends the items to `out` in order, freeing each block once it is copied: at most one
+  /// block more than the items is alive, where growing `out` block by block would copy them
+  /// again at each doubling.
+  void drain_into(std::vector<T>& out) {
+    for (std::size_t i = 0; i < used_; ++i) {
+      out.insert(out.end(), blocks_[i].begin(), blocks_[i].end());
+      std::vector<T>().swap(blocks_[i]);
+    }
+    blocks_.clear();
+    used_ = 0;
+    cur_ = nullptr;
   }
 
  private:
@@ -57,10 +70,28 @@ class PairBlocks {
     cur_ = &blocks_[used_++];
   }
 
-  std::vector<std::vector<FacePair>> blocks_;  // only the first used_ hold this call's pairs
+  std::vector<std::vector<T>> blocks_;  // only the first used_ hold this call's items
   std::size_t used_ = 0;
-  std::vector<FacePair>* cur_ = nullptr;  // blocks_[used_ - 1], or none yet
+  std::vector<T>* cur_ = nullptr;  // blocks_[used_ - 1], or none yet
 };
+
+/// The traversal's pairs of one thread.
+class PairBlocks : public Blocks<FacePair> {
+ public:
+  void push(int a, int b) { push_back({a, b}); }
+};
+
+/// Moves the items of every thread's blocks `member` (a pointer to a Blocks<T> member of the
+/// buffers) to the end of `out`, sized once for all of them.
+template <class T, class Locals, class Buffer>
+void drain_into(Locals& locals, Blocks<T> Buffer::*member, std::vector<T>& out) {
+  std::size_t n = out.size();
+  for (const auto& l : locals)
+    n += (l.*member).size();
+  out.reserve(n);
+  for (auto& l : locals)
+    (l.*member).drain_into(out);
+}
 
 /// A step's pairs as views of the blocks that hold them (or of any contiguous pair lists).
 class PairList {

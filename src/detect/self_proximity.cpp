@@ -11,9 +11,11 @@
 
 namespace clothcd::detail {
 namespace {
+// A large query finds millions of pairs: in blocks, which neither copy them as they grow nor
+// hold twice their memory at a doubling, and which are freed as they are gathered.
 struct ProximityBuffer : LoopBuffers {
-  std::vector<ProximityResult::VertexFace> vf;
-  std::vector<ProximityResult::EdgeEdge> ee;
+  Blocks<ProximityResult::VertexFace> vf;
+  Blocks<ProximityResult::EdgeEdge> ee;
 };
 }  // namespace
 
@@ -69,10 +71,8 @@ ProximityResult SelfCore::proximity(PointsIn p, double h) {
   orphan_pairs(ctx, scope(), locals, kvf, kee);
   ProximityResult res;
   res.reused_pairs = reused;
-  for (const auto& l : locals) {
-    res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
-    res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
-  }
+  drain_into(locals, &ProximityBuffer::vf, res.vf);
+  drain_into(locals, &ProximityBuffer::ee, res.ee);
   std::sort(res.vf.begin(), res.vf.end(), [](const auto& a, const auto& b) {
     return std::pair(a.vertex, a.face) < std::pair(b.vertex, b.face);
   });
