@@ -87,23 +87,38 @@ DetectResult SelfCore::detect(PointsIn p0, PointsIn p1, bool kernels) {
   DetectResult res;
   DetectStats& st = res.stats;
   refit(st);
+  // The boxes first: the narrow phase then follows the traversal a round of pairs at a time
+  // (traverse_each).
   auto t = Clock::now();
-  const PairList pairs = traverse(rule(), scope(), st, pair_locals, opt.reuse_front && !restricted);
-  st.time_traverse = seconds_since(t);
-  t = Clock::now();
   FeatureContext ctx = ccd_context();
   ctx.plan.kernel = kernels;
   boxes.update(ctx, step);
+  double narrow_s = seconds_since(t);
   const bool keep = keeps() && !restricted;
+  if (keep) {
+    reuse.valid = false;  // until every round's pairs are in
+    reuse.pairs.clear();
+  }
   std::vector<std::uint8_t> near;
-  narrow(ctx, pairs, scope(), res, keep ? &near : nullptr);
-  st.time_narrow = seconds_since(t);
+  NarrowLocals locals;
+  traverse_each(rule(), scope(), st, pair_locals, opt.reuse_front && !restricted,
+                [&](const PairList& pairs) {
+                  const auto t0 = Clock::now();
+                  narrow_pairs(ctx, pairs, scope(), locals, keep ? &near : nullptr);
+                  narrow_s += seconds_since(t0);
+                  if (!keep) return;
+                  pairs.for_each([&](std::size_t i, const FacePair& p) {
+                    if (near[i] != 0) reuse.pairs.push_back(p);
+                  });
+                });
+  t = Clock::now();
+  narrow_orphans(ctx, scope(), locals);
+  st.triangle_pairs = 0;
+  gather(locals, res);
+  finish(res);
+  st.time_narrow = narrow_s + seconds_since(t);
   if (keep) {
     reuse.x1 = v1;
-    reuse.pairs.clear();
-    pairs.for_each([&](std::size_t i, const FacePair& p) {
-      if (near[i] != 0) reuse.pairs.push_back(p);
-    });
     reuse.valid = true;
   }
   return res;

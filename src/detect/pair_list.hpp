@@ -18,10 +18,10 @@ namespace clothcd::detail {
 using FacePair = std::pair<int, int>;
 
 /// One thread's items, filled in order into blocks: the first of 64 Ki items (512 KiB of pairs,
-/// enough for a garment-sized step), the others of 512 Ki items (4 MiB of pairs: large enough for
-/// the command-line tool to put them on huge pages, whose faults are fewer). clear() empties them
-/// and keeps their memory; drain_into() moves them out and frees it.
-template <class T>
+/// enough for a garment-sized step), the others of kLarge items (512 Ki: 4 MiB of pairs, large
+/// enough for the command-line tool to put them on huge pages, whose faults are fewer). clear()
+/// empties them and keeps their memory; drain_into() moves them out and frees it.
+template <class T, std::size_t kLarge = std::size_t{1} << 19>
 class Blocks {
  public:
   void push_back(const T& x) {
@@ -60,7 +60,7 @@ class Blocks {
   }
 
  private:
-  static constexpr std::size_t kFirst = std::size_t{1} << 16, kLarge = std::size_t{1} << 19;
+  static constexpr std::size_t kFirst = std::size_t{1} << 16;
 
   void next_block() {
     if (used_ == blocks_.size()) {
@@ -81,10 +81,17 @@ class PairBlocks : public Blocks<FacePair> {
   void push(int a, int b) { push_back({a, b}); }
 };
 
-/// Moves the items of every thread's blocks `member` (a pointer to a Blocks<T> member of the
+/// Blocks of 32 MiB for items that drain_into() gathers: the allocator maps and unmaps a block
+/// that large on its own (glibc does from 32 MiB on, whatever its threshold has grown to), so
+/// the memory of each block is returned as soon as it is copied, and the gather holds little
+/// more than the items once.
+template <class T>
+using MappedBlocks = Blocks<T, (std::size_t{32} << 20) / sizeof(T)>;
+
+/// Moves the items of every thread's blocks `member` (a pointer to a Blocks member of the
 /// buffers) to the end of `out`, sized once for all of them.
-template <class T, class Locals, class Buffer>
-void drain_into(Locals& locals, Blocks<T> Buffer::*member, std::vector<T>& out) {
+template <class T, std::size_t kLarge, class Locals, class Buffer>
+void drain_into(Locals& locals, Blocks<T, kLarge> Buffer::*member, std::vector<T>& out) {
   std::size_t n = out.size();
   for (const auto& l : locals)
     n += (l.*member).size();

@@ -14,8 +14,8 @@ namespace {
 // A large query finds millions of pairs: in blocks, which neither copy them as they grow nor
 // hold twice their memory at a doubling, and which are freed as they are gathered.
 struct ProximityBuffer : LoopBuffers {
-  Blocks<ProximityResult::VertexFace> vf;
-  Blocks<ProximityResult::EdgeEdge> ee;
+  MappedBlocks<ProximityResult::VertexFace> vf;
+  MappedBlocks<ProximityResult::EdgeEdge> ee;
 };
 }  // namespace
 
@@ -64,9 +64,11 @@ ProximityResult SelfCore::proximity(PointsIn p, double h) {
     } unrestrict{*this};
     test_pairs(PairList(reuse.pairs), Scope::Inactive);
     reused = reuse.pairs.size();
-    test_pairs(traverse(Rule::None, Scope::Active, st, pair_locals), Scope::Active);
+    traverse_each(Rule::None, Scope::Active, st, pair_locals, false,
+                  [&](const PairList& pairs) { test_pairs(pairs, Scope::Active); });
   } else {
-    test_pairs(traverse(Rule::None, scope(), st, pair_locals), scope());
+    traverse_each(Rule::None, scope(), st, pair_locals, false,
+                  [&](const PairList& pairs) { test_pairs(pairs, scope()); });
   }
   orphan_pairs(ctx, scope(), locals, kvf, kee);
   ProximityResult res;
