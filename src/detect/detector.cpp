@@ -9,7 +9,11 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <string_view>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "bvh/optimal_cones.hpp"
 #include "clothcd/core/error.hpp"
@@ -19,6 +23,17 @@
 
 namespace clothcd {
 namespace detail {
+
+namespace {
+// A build's temporaries (the tree's and the topology's, many freed by worker threads) leave free
+// memory in the allocator's arenas, which the process keeps resident: about 330 MB after a build
+// on 4M triangles, beside the detector's 1.4 GB. Returned to the system once the build is done.
+void return_free_memory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
+}  // namespace
 
 void check_self_options(const DetectOptions& o) {
   check_common_options(o);
@@ -47,6 +62,7 @@ SelfCore::SelfCore(std::vector<Face> faces, int nv, PointsIn ref, const DetectOp
   cull = o.culling == Culling::Sound ? Rule::Sound : Rule::None;
   orphans = find_orphans(topo);
   owner = Ownership(topo);
+  return_free_memory();
 }
 
 void SelfCore::set_options(const DetectOptions& o) {
@@ -131,6 +147,7 @@ namespace {
 void rebuild_detector(detail::SelfCore& im, detail::PointsIn reference) {
   im.rebuild(reference, "reference shape", im.opt.build, true);
   im.front.clear();  // the front's node pairs belonged to the old tree
+  detail::return_free_memory();
 }
 }  // namespace
 

@@ -10,9 +10,9 @@ namespace clothcd::detail {
 enum class BoxStore : std::uint8_t {
   Separate,  // one array per kind (vertices, edges, faces)
   Both,      // those arrays and the face blocks (FaceBoxes) that gather them per face
-  // The vertex array and the face blocks only: an edge's and a face's boxes are read from a
-  // block (FeatureContext::edge_box, face_box). The pair loop reads the blocks alone, and the
-  // arrays would take another 60 bytes a face (240 MB on 4M triangles).
+  // The face blocks only: a vertex's, an edge's and a face's boxes are read from a block
+  // (FeatureContext::vertex_box, edge_box, face_box). The pair loop reads the blocks alone, and
+  // the arrays would take another 72 bytes a face (290 MB on 4M triangles).
   Blocks,
 };
 
@@ -31,7 +31,7 @@ class FeatureBoxes {
   explicit FeatureBoxes(BoxStore store) : store_(store) {}
 
   /// Brings the boxes up to date with ctx's positions and margin and points ctx at them (at no
-  /// edge or face array with BoxStore::Blocks). ctx's positions must be `step`'s current ones:
+  /// arrays with BoxStore::Blocks). ctx's positions must be `step`'s current ones:
   /// when the boxes were last updated at the previous call of `step` with the same margin, only
   /// the features of its changed vertices are redone.
   void update(FeatureContext& ctx, const StepPositions& step) {
@@ -43,8 +43,8 @@ class FeatureBoxes {
     call_ = step.call();
     const bool arrays = store_ != BoxStore::Blocks, blocks = store_ != BoxStore::Separate;
     if (moved.empty()) {
-      vboxes_.resize(nv);
       if (arrays) {
+        vboxes_.resize(nv);
         eboxes_.resize(topo.num_edges());
         fboxes_.resize(topo.num_faces());
       }
@@ -57,51 +57,67 @@ class FeatureBoxes {
       }
       return false;
     };
-    for_each(nv, [&](int i) {
-      if (redo(std::array<int, 1>{i})) vboxes_[i] = ctx.compute_vertex_box(i);
-    });
     // An edge's or face's box is the union of its vertices' boxes bit for bit: swept_feature_box's
     // rounding (minus the margin, next_down, to float downwards) is monotone, so the rounded
     // minimum of the points is the minimum of their rounded values (likewise upwards).
     if (arrays) {
+      for_each(nv, [&](int i) {
+        if (redo(std::array<int, 1>{i})) vboxes_[i] = ctx.compute_vertex_box(i);
+      });
       for_each(topo.num_edges(), [&](int e) {
-        if (redo(topo.edges()[e])) eboxes_[e] = merged(topo.edges()[e]);
+        if (redo(topo.edges()[e])) eboxes_[e] = merged(vboxes_, topo.edges()[e]);
       });
       for_each(topo.num_faces(), [&](int f) {
-        if (redo(topo.faces()[f])) fboxes_[f] = merged(topo.faces()[f]);
+        if (redo(topo.faces()[f])) fboxes_[f] = merged(vboxes_, topo.faces()[f]);
       });
     }
     if (blocks) {
       // A face's block holds its own, its edges' and its corners' boxes, redone exactly when one
-      // of those is (a vertex of the face moved). Without the arrays, the same merges of the same
-      // vertex boxes in the same order: the same bits.
+      // of those is (a vertex of the face moved). Without the arrays, the corners' boxes are
+      // computed here and merged in the same order: the same bits.
       for_each(topo.num_faces(), [&](int f) {
         const Face& t = topo.faces()[f];
         if (!redo(t)) return;
         FaceBoxes& b = blocks_[f];
-        const auto edges = topo.face_edges(f);
-        const Box face = arrays ? fboxes_[f] : merged(t);
-        for (int k = 0; k < 3; ++k) {
-          const int e = edges[k];
-          b.set(FaceBoxes::kEdges + k, arrays ? eboxes_[e] : merged(topo.edges()[e]));
-          b.set(FaceBoxes::kCorners + k, vboxes_[t[k]]);
+        const auto& edges = topo.face_edges(f);
+        if (arrays) {
+          for (int k = 0; k < 3; ++k) {
+            b.set(FaceBoxes::kEdges + k, eboxes_[edges[k]]);
+            b.set(FaceBoxes::kCorners + k, vboxes_[t[k]]);
+          }
+          b.set(FaceBoxes::kFace, fboxes_[f]);
+          b.set(7, fboxes_[f]);
+          return;
         }
+        const std::array<Box, 3> corner = {ctx.compute_vertex_box(t[0]),
+                                           ctx.compute_vertex_box(t[1]),
+                                           ctx.compute_vertex_box(t[2])};
+        for (int k = 0; k < 3; ++k) {
+          // Edge k joins corners k and k + 1, merged in the order Topology::edges() lists them.
+          const int k1 = k == 2 ? 0 : k + 1;
+          const bool ordered = topo.edges()[edges[k]][0] == t[k];
+          const std::array<int, 2> ends = ordered ? std::array{k, k1} : std::array{k1, k};
+          b.set(FaceBoxes::kEdges + k, merged(corner, ends));
+          b.set(FaceBoxes::kCorners + k, corner[k]);
+        }
+        const Box face = merged(corner, std::array{0, 1, 2});
         b.set(FaceBoxes::kFace, face);
         b.set(7, face);
       });
       ctx.face_boxes = blocks_;
     }
-    ctx.vboxes = vboxes_;
+    ctx.vboxes = arrays ? std::span<const Box>(vboxes_) : std::span<const Box>();
     ctx.eboxes = arrays ? std::span<const Box>(eboxes_) : std::span<const Box>();
     ctx.fboxes = arrays ? std::span<const Box>(fboxes_) : std::span<const Box>();
   }
 
  private:
-  template <class Ids>
-  [[nodiscard]] Box merged(const Ids& ids) const {
-    Box b = vboxes_[ids[0]];
+  // The union of boxes[ids[0]], boxes[ids[1]], ... in that order.
+  template <class Boxes, class Ids>
+  [[nodiscard]] static Box merged(const Boxes& boxes, const Ids& ids) {
+    Box b = boxes[ids[0]];
     for (std::size_t k = 1; k < ids.size(); ++k) {
-      const Box& o = vboxes_[ids[k]];
+      const Box& o = boxes[ids[k]];
       for (int a = 0; a < 3; ++a) {
         b.lo[a] = std::min(b.lo[a], o.lo[a]);
         b.hi[a] = std::max(b.hi[a], o.hi[a]);

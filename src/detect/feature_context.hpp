@@ -97,14 +97,19 @@ struct FeatureContext {
     const Edge& d = topo->edges()[e];
     return swept_feature_box({&v0[d[0]], &v0[d[1]], &v1[d[0]], &v1[d[1]]}, margin);
   }
-  // The precomputed boxes where there are any: the arrays, else the face blocks (an edge's box
-  // from its first face's block; the same bits), else computed.
+  // The precomputed boxes where there are any: the arrays, else the face blocks (a vertex's or
+  // an edge's box from its first face's block; the same bits), else computed.
   [[nodiscard]] Box face_box(int f) const {
     if (!fboxes.empty()) return fboxes[f];
     return face_boxes.empty() ? compute_face_box(f) : face_boxes[f].face();
   }
   [[nodiscard]] Box vertex_box(int v) const {
-    return vboxes.empty() ? compute_vertex_box(v) : vboxes[v];
+    if (!vboxes.empty()) return vboxes[v];
+    const auto faces = topo->vertex_faces(v);
+    if (face_boxes.empty() || faces.empty()) return compute_vertex_box(v);
+    const Face& t = topo->faces()[faces[0]];
+    const int k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+    return face_boxes[faces[0]].get(FaceBoxes::kCorners + k);
   }
   [[nodiscard]] Box edge_box(int e) const {
     if (!eboxes.empty()) return eboxes[e];
