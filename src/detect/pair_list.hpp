@@ -9,9 +9,15 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <memory>
+#include <new>
 #include <span>
 #include <utility>
 #include <vector>
+
+#if defined(__unix__)
+#include <sys/mman.h>
+#endif
 
 namespace clothcd::detail {
 
@@ -21,7 +27,7 @@ using FacePair = std::pair<int, int>;
 /// enough for a garment-sized step), the others of kLarge items (512 Ki: 4 MiB of pairs, large
 /// enough for the command-line tool to put them on huge pages, whose faults are fewer). clear()
 /// empties them and keeps their memory; drain_into() moves them out and frees it.
-template <class T, std::size_t kLarge = std::size_t{1} << 19>
+template <class T, std::size_t kLarge = std::size_t{1} << 19, class Alloc = std::allocator<T>>
 class Blocks {
  public:
   void push_back(const T& x) {
@@ -52,7 +58,7 @@ class Blocks {
   void drain_into(std::vector<T>& out) {
     for (std::size_t i = 0; i < used_; ++i) {
       out.insert(out.end(), blocks_[i].begin(), blocks_[i].end());
-      std::vector<T>().swap(blocks_[i]);
+      std::vector<T, Alloc>().swap(blocks_[i]);
     }
     blocks_.clear();
     used_ = 0;
@@ -70,9 +76,9 @@ class Blocks {
     cur_ = &blocks_[used_++];
   }
 
-  std::vector<std::vector<T>> blocks_;  // only the first used_ hold this call's items
+  std::vector<std::vector<T, Alloc>> blocks_;  // only the first used_ hold this call's items
   std::size_t used_ = 0;
-  std::vector<T>* cur_ = nullptr;  // blocks_[used_ - 1], or none yet
+  std::vector<T, Alloc>* cur_ = nullptr;  // blocks_[used_ - 1], or none yet
 };
 
 /// The traversal's pairs of one thread.
@@ -81,17 +87,54 @@ class PairBlocks : public Blocks<FacePair> {
   void push(int a, int b) { push_back({a, b}); }
 };
 
-/// Blocks of 32 MiB for items that drain_into() gathers: the allocator maps and unmaps a block
-/// that large on its own (glibc does from 32 MiB on, whatever its threshold has grown to), so
-/// the memory of each block is returned as soon as it is copied, and the gather holds little
-/// more than the items once.
+/// An allocator that maps each allocation of more than 1 MiB from the system and unmaps it when
+/// it is freed, so that its memory leaves the process at once (freed to the C allocator, it can
+/// stay resident in an arena, for whatever the process allocates next).
 template <class T>
-using MappedBlocks = Blocks<T, (std::size_t{32} << 20) / sizeof(T)>;
+struct MappedAllocator {
+  using value_type = T;
+  static constexpr std::size_t kMapped = std::size_t{1} << 20;
+
+  MappedAllocator() = default;
+  template <class U>
+  MappedAllocator(const MappedAllocator<U>&) {}  // NOLINT: implicit, as allocators convert
+
+  T* allocate(std::size_t n) {
+#if defined(__unix__)
+    if (n * sizeof(T) > kMapped) {
+      void* p =
+          mmap(nullptr, n * sizeof(T), PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (p == MAP_FAILED) throw std::bad_alloc();
+      return static_cast<T*>(p);
+    }
+#endif
+    return std::allocator<T>().allocate(n);
+  }
+  void deallocate(T* p, std::size_t n) {
+#if defined(__unix__)
+    if (n * sizeof(T) > kMapped) {
+      munmap(p, n * sizeof(T));
+      return;
+    }
+#endif
+    std::allocator<T>().deallocate(p, n);
+  }
+  friend bool operator==(const MappedAllocator&, const MappedAllocator&) {
+    return true;
+  }
+};
+
+/// Blocks for items that drain_into() gathers: the first of 64 Ki items, from the C allocator
+/// (a garment-sized query's), the others of 4 MiB, mapped (MappedAllocator), so that the gather
+/// returns each block's memory as soon as it is copied and holds little more than the items
+/// once.
+template <class T>
+using MappedBlocks = Blocks<T, (std::size_t{4} << 20) / sizeof(T), MappedAllocator<T>>;
 
 /// Moves the items of every thread's blocks `member` (a pointer to a Blocks member of the
 /// buffers) to the end of `out`, sized once for all of them.
-template <class T, std::size_t kLarge, class Locals, class Buffer>
-void drain_into(Locals& locals, Blocks<T, kLarge> Buffer::*member, std::vector<T>& out) {
+template <class T, std::size_t kLarge, class Alloc, class Locals, class Buffer>
+void drain_into(Locals& locals, Blocks<T, kLarge, Alloc> Buffer::*member, std::vector<T>& out) {
   std::size_t n = out.size();
   for (const auto& l : locals)
     n += (l.*member).size();
