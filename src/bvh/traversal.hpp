@@ -207,7 +207,8 @@ Traversal<Cull, Leaf> make_traversal(std::span<const BvhNode> na, std::span<cons
 /// has its own `Local` (output buffer) and counters. With `rounds` > 1, the tasks run in that
 /// many consecutive parallel rounds, and after_round() is called after each (the leaf pairs of
 /// the frontier's expansion go with the first): a caller that consumes and empties the buffers
-/// there holds one round's output at a time. The same tasks, box tests and culls either way.
+/// there holds one round's output at a time. The frontier has 512 tasks a round; the same box
+/// tests, culls and leaf pairs whatever its width.
 template <class Tr, class Local, class AfterRound>
 TraversalCounters run_parallel(const Tr& tr, const Task& root,
                                tbb::enumerable_thread_specific<Local>& locals, std::size_t rounds,
@@ -215,9 +216,10 @@ TraversalCounters run_parallel(const Tr& tr, const Task& root,
   TraversalCounters total;
   std::deque<Task> frontier{root};
   Local& serial = locals.local();
-  constexpr std::size_t kFrontier = 512;
+  // Wide enough for every round to keep the threads busy.
+  const std::size_t width = std::size_t{512} * std::max<std::size_t>(1, rounds);
   // Breadth-first expansion until the frontier is wide enough (or the tree is exhausted).
-  for (int guard = 0; !frontier.empty() && frontier.size() < kFrontier && guard < 100000; ++guard) {
+  for (int guard = 0; !frontier.empty() && frontier.size() < width && guard < 100000; ++guard) {
     const Task t = frontier.front();
     frontier.pop_front();
     tr.step(t, total, serial, [&](const Task& s) { frontier.push_back(s); });
