@@ -166,9 +166,10 @@ void Bvh::refit_flagged(std::span<const Eigen::Vector3d> v_t0,
                         bool optimal, std::span<const std::uint8_t> moved) {
   std::vector<std::uint8_t> touched;
   if (!moved.empty()) {
-    touched.assign(faces_.size(), 0);
-    for (std::size_t f = 0; f < faces_.size(); ++f) {
-      for (int v : faces_[f])
+    const std::vector<Face>& faces = this->faces();
+    touched.assign(faces.size(), 0);
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+      for (int v : faces[f])
         touched[f] |= moved[v];
     }
   }
@@ -185,7 +186,7 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
   // Optimal cones start from exact leaf caps.
   const LeafConePolicy lp = optimal_cones ? LeafConePolicy::Exact : leaf_policy(options.policy);
   const bool optimal = options.cones && optimal_cones;
-  const auto& faces = faces_;
+  const std::vector<Face>& faces = this->faces();
   // Optimal cones need every leaf's control directions.
   const int min_count = optimal ? 0 : options.cone_min_triangles;
   auto patch = [&](int i) {
