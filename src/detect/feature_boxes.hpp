@@ -3,6 +3,7 @@
 // triangle pair's features, one at a time or a face block at a time (feature_overlaps).
 
 #include "detect/feature_context.hpp"
+#include "detect/pair_list.hpp"
 
 namespace clothcd::detail {
 
@@ -73,8 +74,18 @@ class FeatureBoxes {
     }
     if (blocks) {
       // A face's block holds its own, its edges' and its corners' boxes, redone exactly when one
-      // of those is (a vertex of the face moved). Without the arrays, the corners' boxes are
-      // computed here and merged in the same order: the same bits.
+      // of those is (a vertex of the face moved). Without the arrays, the corners' boxes come
+      // from the same function and are merged in the same order: the same bits. When every block
+      // is redone, from a transient array of the vertices' boxes, each computed once (freed
+      // before the call's traversal and results).
+      std::vector<Box, MappedAllocator<Box>> vertex;  // its memory leaves with it
+      if (!arrays && moved.empty()) {
+        vertex.resize(nv);
+        for_each(nv, [&](int i) { vertex[i] = ctx.compute_vertex_box(i); });
+      }
+      const auto vertex_box = [&](int v) {
+        return vertex.empty() ? ctx.compute_vertex_box(v) : vertex[v];
+      };
       for_each(topo.num_faces(), [&](int f) {
         const Face& t = topo.faces()[f];
         if (!redo(t)) return;
@@ -89,9 +100,7 @@ class FeatureBoxes {
           b.set(7, fboxes_[f]);
           return;
         }
-        const std::array<Box, 3> corner = {ctx.compute_vertex_box(t[0]),
-                                           ctx.compute_vertex_box(t[1]),
-                                           ctx.compute_vertex_box(t[2])};
+        const std::array<Box, 3> corner = {vertex_box(t[0]), vertex_box(t[1]), vertex_box(t[2])};
         for (int k = 0; k < 3; ++k) {
           // Edge k joins corners k and k + 1, merged in the order Topology::edges() lists them.
           const int k1 = k == 2 ? 0 : k + 1;
