@@ -349,11 +349,11 @@ void Bvh::build_tree(const Topology& topology, std::span<const Eigen::Vector3d> 
       parent_[nodes_[i].left] = parent_[nodes_[i].left + 1] = i;
     }
   }
-  cones_.resize(nodes_.size());
-  faces_ = topology.faces();
+  cones_.clear();  // sized by the first refit with cones
+  faces_ = topology.shared_faces();
   prim_faces_.resize(prim_ids_.size());
   for (std::size_t i = 0; i < prim_ids_.size(); ++i)
-    prim_faces_[i] = faces_[prim_ids_[i]];
+    prim_faces_[i] = (*faces_)[prim_ids_[i]];
   num_vertices_ = topology.num_vertices();
 }
 

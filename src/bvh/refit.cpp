@@ -58,6 +58,9 @@ void Bvh::refit_levels(const RefitOptions& options, bool optimal_cones,
     if (nodes_[c].count < min_count && (only.empty() || only[c] != 0)) cones_[c] = patch(c);
     return cones_[c];
   };
+  // The cones are allocated by the first refit that fits them (a box-only detector never pays
+  // for them: a 4M-triangle tree's cones take 256 MB).
+  if (options.cones && cones_.size() != nodes_.size()) cones_.resize(nodes_.size());
   if (optimal) {
     control_dirs_.resize(3 * prim_ids_.size());
     degenerate_.resize(prim_ids_.size());
@@ -163,9 +166,10 @@ void Bvh::refit_flagged(std::span<const Eigen::Vector3d> v_t0,
                         bool optimal, std::span<const std::uint8_t> moved) {
   std::vector<std::uint8_t> touched;
   if (!moved.empty()) {
-    touched.assign(faces_.size(), 0);
-    for (std::size_t f = 0; f < faces_.size(); ++f) {
-      for (int v : faces_[f])
+    const std::vector<Face>& faces = this->faces();
+    touched.assign(faces.size(), 0);
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+      for (int v : faces[f])
         touched[f] |= moved[v];
     }
   }
@@ -182,7 +186,7 @@ void Bvh::refit_nodes(std::span<const Eigen::Vector3d> v_t0, std::span<const Eig
   // Optimal cones start from exact leaf caps.
   const LeafConePolicy lp = optimal_cones ? LeafConePolicy::Exact : leaf_policy(options.policy);
   const bool optimal = options.cones && optimal_cones;
-  const auto& faces = faces_;
+  const std::vector<Face>& faces = this->faces();
   // Optimal cones need every leaf's control directions.
   const int min_count = optimal ? 0 : options.cone_min_triangles;
   auto patch = [&](int i) {

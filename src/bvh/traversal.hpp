@@ -8,6 +8,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <array>
 #include <deque>
 #include <span>
@@ -203,32 +204,49 @@ Traversal<Cull, Leaf> make_traversal(std::span<const BvhNode> na, std::span<cons
 }
 
 /// Expands the root into a frontier of independent tasks, then runs them in parallel. Each thread
-/// has its own `Local` (output buffer) and counters.
-template <class Tr, class Local>
+/// has its own `Local` (output buffer) and counters. With `rounds` > 1, the tasks run in that
+/// many consecutive parallel rounds, and after_round() is called after each (the leaf pairs of
+/// the frontier's expansion go with the first): a caller that consumes and empties the buffers
+/// there holds one round's output at a time. The frontier has 512 tasks a round; the same box
+/// tests, culls and leaf pairs whatever its width.
+template <class Tr, class Local, class AfterRound>
 TraversalCounters run_parallel(const Tr& tr, const Task& root,
-                               tbb::enumerable_thread_specific<Local>& locals) {
+                               tbb::enumerable_thread_specific<Local>& locals, std::size_t rounds,
+                               AfterRound&& after_round) {
   TraversalCounters total;
   std::deque<Task> frontier{root};
   Local& serial = locals.local();
-  constexpr std::size_t kFrontier = 512;
+  // Wide enough for every round to keep the threads busy.
+  const std::size_t width = std::size_t{512} * std::max<std::size_t>(1, rounds);
   // Breadth-first expansion until the frontier is wide enough (or the tree is exhausted).
-  for (int guard = 0; !frontier.empty() && frontier.size() < kFrontier && guard < 100000; ++guard) {
+  for (int guard = 0; !frontier.empty() && frontier.size() < width && guard < 100000; ++guard) {
     const Task t = frontier.front();
     frontier.pop_front();
     tr.step(t, total, serial, [&](const Task& s) { frontier.push_back(s); });
   }
   std::vector<Task> tasks(frontier.begin(), frontier.end());
   tbb::enumerable_thread_specific<TraversalCounters> counters;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tasks.size(), 1),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      Local& local = locals.local();
-                      TraversalCounters& c = counters.local();
-                      for (std::size_t i = r.begin(); i != r.end(); ++i)
-                        tr.run(tasks[i], c, local);
-                    });
+  rounds = std::max<std::size_t>(1, std::min(rounds, tasks.size()));
+  for (std::size_t k = 0; k < rounds; ++k) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(k * tasks.size() / rounds,
+                                                      (k + 1) * tasks.size() / rounds, 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        Local& local = locals.local();
+                        TraversalCounters& c = counters.local();
+                        for (std::size_t i = r.begin(); i != r.end(); ++i)
+                          tr.run(tasks[i], c, local);
+                      });
+    after_round();
+  }
   for (const auto& c : counters)
     total.add(c);
   return total;
+}
+
+template <class Tr, class Local>
+TraversalCounters run_parallel(const Tr& tr, const Task& root,
+                               tbb::enumerable_thread_specific<Local>& locals) {
+  return run_parallel(tr, root, locals, 1, [] {});
 }
 
 }  // namespace clothcd::detail

@@ -3,8 +3,19 @@
 // triangle pair's features, one at a time or a face block at a time (feature_overlaps).
 
 #include "detect/feature_context.hpp"
+#include "detect/pair_list.hpp"
 
 namespace clothcd::detail {
+
+/// Where FeatureBoxes keeps a step's edge and face boxes.
+enum class BoxStore : std::uint8_t {
+  Separate,  // one array per kind (vertices, edges, faces)
+  Both,      // those arrays and the face blocks (FaceBoxes) that gather them per face
+  // The face blocks only: a vertex's, an edge's and a face's boxes are read from a block
+  // (FeatureContext::vertex_box, edge_box, face_box). The pair loop reads the blocks alone, and
+  // the arrays would take another 72 bytes a face (290 MB on 4M triangles).
+  Blocks,
+};
 
 /// The swept boxes of every vertex, edge and face for one step, kept between steps: `update`
 /// recomputes only the boxes of features with a vertex whose positions (t0 or t1) changed since
@@ -16,11 +27,14 @@ class FeatureBoxes {
  public:
   /// `face_blocks`: also keep each face's boxes gathered as a FaceBoxes (FeatureContext::
   /// face_boxes), for the pair loop of owned_feature_pairs.
-  explicit FeatureBoxes(bool face_blocks = false) : blocks_on_(face_blocks) {}
+  explicit FeatureBoxes(bool face_blocks = false)
+      : store_(face_blocks ? BoxStore::Both : BoxStore::Separate) {}
+  explicit FeatureBoxes(BoxStore store) : store_(store) {}
 
-  /// Brings the boxes up to date with ctx's positions and margin and points ctx at them. ctx's
-  /// positions must be `step`'s current ones: when the boxes were last updated at the previous
-  /// call of `step` with the same margin, only the features of its changed vertices are redone.
+  /// Brings the boxes up to date with ctx's positions and margin and points ctx at them (at no
+  /// arrays with BoxStore::Blocks). ctx's positions must be `step`'s current ones:
+  /// when the boxes were last updated at the previous call of `step` with the same margin, only
+  /// the features of its changed vertices are redone.
   void update(FeatureContext& ctx, const StepPositions& step) {
     const Topology& topo = *ctx.topo;
     const int nv = topo.num_vertices();
@@ -28,11 +42,14 @@ class FeatureBoxes {
     if (margin_ != ctx.margin) moved = {};  // every box changes: start over
     margin_ = ctx.margin;
     call_ = step.call();
+    const bool arrays = store_ != BoxStore::Blocks, blocks = store_ != BoxStore::Separate;
     if (moved.empty()) {
-      vboxes_.resize(nv);
-      eboxes_.resize(topo.num_edges());
-      fboxes_.resize(topo.num_faces());
-      if (blocks_on_) blocks_.resize(topo.num_faces());
+      if (arrays) {
+        vboxes_.resize(nv);
+        eboxes_.resize(topo.num_edges());
+        fboxes_.resize(topo.num_faces());
+      }
+      if (blocks) blocks_.resize(topo.num_faces());
     }
     const auto redo = [&](auto&& ids) {  // a vertex of the feature moved (or all did)
       if (moved.empty()) return true;
@@ -41,46 +58,75 @@ class FeatureBoxes {
       }
       return false;
     };
-    for_each(nv, [&](int i) {
-      if (redo(std::array<int, 1>{i})) vboxes_[i] = ctx.compute_vertex_box(i);
-    });
     // An edge's or face's box is the union of its vertices' boxes bit for bit: swept_feature_box's
     // rounding (minus the margin, next_down, to float downwards) is monotone, so the rounded
     // minimum of the points is the minimum of their rounded values (likewise upwards).
-    for_each(topo.num_edges(), [&](int e) {
-      if (redo(topo.edges()[e])) eboxes_[e] = merged(topo.edges()[e]);
-    });
-    for_each(topo.num_faces(), [&](int f) {
-      if (redo(topo.faces()[f])) fboxes_[f] = merged(topo.faces()[f]);
-    });
-    if (blocks_on_) {
-      // A face's block holds its own, its edges' and its corners' boxes: copies, redone exactly
-      // when one of those is (a vertex of the face moved).
+    if (arrays) {
+      for_each(nv, [&](int i) {
+        if (redo(std::array<int, 1>{i})) vboxes_[i] = ctx.compute_vertex_box(i);
+      });
+      for_each(topo.num_edges(), [&](int e) {
+        if (redo(topo.edges()[e])) eboxes_[e] = merged(vboxes_, topo.edges()[e]);
+      });
+      for_each(topo.num_faces(), [&](int f) {
+        if (redo(topo.faces()[f])) fboxes_[f] = merged(vboxes_, topo.faces()[f]);
+      });
+    }
+    if (blocks) {
+      // A face's block holds its own, its edges' and its corners' boxes, redone exactly when one
+      // of those is (a vertex of the face moved). Without the arrays, the corners' boxes come
+      // from the same function and are merged in the same order: the same bits. When every block
+      // is redone, from a transient array of the vertices' boxes, each computed once (freed
+      // before the call's traversal and results).
+      std::vector<Box, MappedAllocator<Box>> vertex;  // its memory leaves with it
+      if (!arrays && moved.empty()) {
+        vertex.resize(nv);
+        for_each(nv, [&](int i) { vertex[i] = ctx.compute_vertex_box(i); });
+      }
+      const auto vertex_box = [&](int v) {
+        return vertex.empty() ? ctx.compute_vertex_box(v) : vertex[v];
+      };
       for_each(topo.num_faces(), [&](int f) {
         const Face& t = topo.faces()[f];
         if (!redo(t)) return;
         FaceBoxes& b = blocks_[f];
-        const auto edges = topo.face_edges(f);
-        for (int k = 0; k < 3; ++k) {
-          b.set(FaceBoxes::kEdges + k, eboxes_[edges[k]]);
-          b.set(FaceBoxes::kCorners + k, vboxes_[t[k]]);
+        const auto& edges = topo.face_edges(f);
+        if (arrays) {
+          for (int k = 0; k < 3; ++k) {
+            b.set(FaceBoxes::kEdges + k, eboxes_[edges[k]]);
+            b.set(FaceBoxes::kCorners + k, vboxes_[t[k]]);
+          }
+          b.set(FaceBoxes::kFace, fboxes_[f]);
+          b.set(7, fboxes_[f]);
+          return;
         }
-        b.set(FaceBoxes::kFace, fboxes_[f]);
-        b.set(7, fboxes_[f]);
+        const std::array<Box, 3> corner = {vertex_box(t[0]), vertex_box(t[1]), vertex_box(t[2])};
+        for (int k = 0; k < 3; ++k) {
+          // Edge k joins corners k and k + 1, merged in the order Topology::edges() lists them.
+          const int k1 = k == 2 ? 0 : k + 1;
+          const bool ordered = topo.edges()[edges[k]][0] == t[k];
+          const std::array<int, 2> ends = ordered ? std::array{k, k1} : std::array{k1, k};
+          b.set(FaceBoxes::kEdges + k, merged(corner, ends));
+          b.set(FaceBoxes::kCorners + k, corner[k]);
+        }
+        const Box face = merged(corner, std::array{0, 1, 2});
+        b.set(FaceBoxes::kFace, face);
+        b.set(7, face);
       });
       ctx.face_boxes = blocks_;
     }
-    ctx.vboxes = vboxes_;
-    ctx.eboxes = eboxes_;
-    ctx.fboxes = fboxes_;
+    ctx.vboxes = arrays ? std::span<const Box>(vboxes_) : std::span<const Box>();
+    ctx.eboxes = arrays ? std::span<const Box>(eboxes_) : std::span<const Box>();
+    ctx.fboxes = arrays ? std::span<const Box>(fboxes_) : std::span<const Box>();
   }
 
  private:
-  template <class Ids>
-  [[nodiscard]] Box merged(const Ids& ids) const {
-    Box b = vboxes_[ids[0]];
+  // The union of boxes[ids[0]], boxes[ids[1]], ... in that order.
+  template <class Boxes, class Ids>
+  [[nodiscard]] static Box merged(const Boxes& boxes, const Ids& ids) {
+    Box b = boxes[ids[0]];
     for (std::size_t k = 1; k < ids.size(); ++k) {
-      const Box& o = vboxes_[ids[k]];
+      const Box& o = boxes[ids[k]];
       for (int a = 0; a < 3; ++a) {
         b.lo[a] = std::min(b.lo[a], o.lo[a]);
         b.hi[a] = std::max(b.hi[a], o.hi[a]);
@@ -97,7 +143,7 @@ class FeatureBoxes {
     });
   }
 
-  bool blocks_on_ = false;
+  BoxStore store_ = BoxStore::Separate;
   std::vector<Box> vboxes_, eboxes_, fboxes_;
   std::vector<FaceBoxes> blocks_;
   std::uint64_t call_ = 0;  // the StepPositions call the boxes were computed at (0: none)

@@ -97,14 +97,27 @@ struct FeatureContext {
     const Edge& d = topo->edges()[e];
     return swept_feature_box({&v0[d[0]], &v0[d[1]], &v1[d[0]], &v1[d[1]]}, margin);
   }
+  // The precomputed boxes where there are any: the arrays, else the face blocks (a vertex's or
+  // an edge's box from its first face's block; the same bits), else computed.
   [[nodiscard]] Box face_box(int f) const {
-    return fboxes.empty() ? compute_face_box(f) : fboxes[f];
+    if (!fboxes.empty()) return fboxes[f];
+    return face_boxes.empty() ? compute_face_box(f) : face_boxes[f].face();
   }
   [[nodiscard]] Box vertex_box(int v) const {
-    return vboxes.empty() ? compute_vertex_box(v) : vboxes[v];
+    if (!vboxes.empty()) return vboxes[v];
+    const auto faces = topo->vertex_faces(v);
+    if (face_boxes.empty() || faces.empty()) return compute_vertex_box(v);
+    const Face& t = topo->faces()[faces[0]];
+    const int k = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+    return face_boxes[faces[0]].get(FaceBoxes::kCorners + k);
   }
   [[nodiscard]] Box edge_box(int e) const {
-    return eboxes.empty() ? compute_edge_box(e) : eboxes[e];
+    if (!eboxes.empty()) return eboxes[e];
+    if (face_boxes.empty()) return compute_edge_box(e);
+    const int h = topo->edge_faces(e)[0];
+    const auto& fe = topo->face_edges(h);
+    const int k = fe[0] == e ? 0 : fe[1] == e ? 1 : 2;
+    return face_boxes[h].get(FaceBoxes::kEdges + k);
   }
 
   /// Whether a vertex of the pair is linked to one of the other: such pairs are never tested.

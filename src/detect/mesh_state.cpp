@@ -16,7 +16,7 @@ Bvh make_tree(const Topology& topo, PointsIn reference, std::string_view what, B
 
 MeshState::MeshState(std::vector<Face> faces, int nv, PointsIn reference, std::string_view what,
                      BvhBuild build, bool cones, bool face_blocks)
-    : topo(std::move(faces), nv), boxes(face_blocks) {
+    : topo(std::move(faces), nv), boxes(face_blocks ? BoxStore::Blocks : BoxStore::Separate) {
   bvh = make_tree(topo, reference, what, build, cones);
 }
 

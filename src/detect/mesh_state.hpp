@@ -37,7 +37,8 @@ struct MeshState {
   std::vector<std::uint8_t> vertex_active, edge_active, face_active, node_active;
 
   /// `cones`: a tree with normal cones and contours (self culling); otherwise boxes only.
-  /// `face_blocks`: feature boxes also gathered per face (FeatureBoxes). `what` names the
+  /// `face_blocks`: feature boxes gathered per face (BoxStore::Blocks); otherwise in separate
+  /// arrays. `what` names the
   /// reference shape in errors.
   MeshState(std::vector<Face> faces, int nv, PointsIn reference, std::string_view what,
             BvhBuild build, bool cones, bool face_blocks);

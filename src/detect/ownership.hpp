@@ -37,23 +37,13 @@ class Ownership {
   Ownership() = default;
   /// Keeps a pointer to `topo`, which must outlive it.
   explicit Ownership(const Topology& topo) : topo_(&topo) {
-    // Every edge's and every face's record depends on the topology alone: filled in parallel.
+    // Every face's record depends on the topology alone: filled in parallel.
     const auto for_each = [](int n, auto&& fn) {
       tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& r) {
         for (int i = r.begin(); i != r.end(); ++i)
           fn(i);
       });
     };
-    pair_.resize(topo.num_edges());
-    for_each(topo.num_edges(), [&](int e) {
-      const auto fs = topo.edge_faces(e);
-      EdgeFaces& r = pair_[e];
-      r.general = fs.size() > 2;
-      for (std::size_t i = 0; i < 2; ++i) {
-        r.f[i] = i < fs.size() ? fs[i] : -1;
-        r.t[i] = i < fs.size() ? topo.faces()[fs[i]] : Face{-1, -1, -1};
-      }
-    });
     records_.resize(topo.num_faces());
     for_each(topo.num_faces(), [&](int f) {
       FaceRecord& r = records_[f];
@@ -118,29 +108,8 @@ class Ownership {
   /// Whether (x, y) (x a face of e1, y of e2, sharing no vertex) is the first non-adjacent face
   /// pair of (e1, e2) in ee_representative's order.
   [[nodiscard]] bool owns_ee(int e1, int e2, int x, int y) const {
-    const EdgeFaces& a = pair_[e1];
-    const EdgeFaces& b = pair_[e2];
-    if (a.general || b.general) return owns_ee_general(e1, e2, x, y);
-    // The same search over the copies (at most two faces per edge, in edge_faces order).
-    for (int i = 0; i < 2 && a.f[i] >= 0; ++i) {
-      for (int j = 0; j < 2 && b.f[j] >= 0; ++j) {
-        if (a.f[i] == x && b.f[j] == y) return true;
-        if (!share_vertex(a.t[i], b.t[j])) return false;
-      }
-    }
-    return false;
-  }
-
- private:
-  // An edge's (first two) faces and their corners side by side: the search touches one record
-  // per edge instead of the offset, id and face arrays.
-  struct EdgeFaces {
-    int f[2];  // -1 past the edge's faces
-    Face t[2];
-    bool general;  // more than two faces: use owns_ee_general
-  };
-
-  [[nodiscard]] bool owns_ee_general(int e1, int e2, int x, int y) const {
+    // Read from the topology: few feature pairs need the search (the records settle the
+    // others), and per-edge copies of the faces would take 8 to 36 bytes an edge.
     const auto& faces = topo_->faces();
     for (int fa : topo_->edge_faces(e1)) {
       for (int fb : topo_->edge_faces(e2)) {
@@ -151,8 +120,8 @@ class Ownership {
     return false;
   }
 
+ private:
   const Topology* topo_ = nullptr;
-  std::vector<EdgeFaces> pair_;
   std::vector<FaceRecord> records_;
 };
 

@@ -9,8 +9,10 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -187,8 +189,26 @@ struct SelfCore : MeshState {
   // order and the box tests differ.
   PairList traverse(Rule mode, Scope scope, DetectStats& st, PairLocals& locals,
                     bool from_front = false);
-  // traverse()'s walk from the root, in parallel over a frontier of tasks.
-  TraversalCounters traverse_root(Rule mode, Scope scope, PairLocals& locals);
+  // traverse()'s pairs handed to round(pairs) a part at a time, `locals` emptied after each: on a
+  // large mesh the walk from the root runs in rounds of its tasks (traversal_rounds()), and only
+  // one round's pairs are held at once (millions of pairs otherwise: 250 MB for a proximity
+  // query on 4M triangles). The same pairs, box tests and culls as traverse(), and its stats;
+  // st.time_traverse is the walk's time, round()'s excluded.
+  void traverse_each(Rule mode, Scope scope, DetectStats& st, PairLocals& locals, bool from_front,
+                     const std::function<void(const PairList&)>& round);
+  // The rounds of traverse_each()'s walk from the root: one up to 2^18 triangles (whose pairs
+  // take a few MB), then one per 2^18 triangles, at most 16.
+  [[nodiscard]] std::size_t traversal_rounds() const {
+    return std::clamp<std::size_t>(static_cast<std::size_t>(topo.num_faces()) >> 18, 1, 16);
+  }
+  // traverse()'s walk from the root, in parallel over a frontier of tasks; in `rounds` rounds
+  // of them, after_round() after each (run_parallel).
+  TraversalCounters traverse_root(Rule mode, Scope scope, PairLocals& locals,
+                                  std::size_t rounds = 1,
+                                  const std::function<void()>& after_round = {});
+  // The traversal's counters and the adjacent pairs of `locals` into `st`.
+  void record_traversal(const TraversalCounters& c, bool from_front, const PairLocals& locals,
+                        DetectStats& st) const;
   // traverse()'s walk from the front: first the self tests the walk from the root makes, a level
   // at a time (bit 0 of front_live[n]: the self test of n runs, its parent's did and was not
   // culled; bit 1: n is internal and not culled, so the pairs of its children are traversed),

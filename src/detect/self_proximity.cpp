@@ -11,9 +11,11 @@
 
 namespace clothcd::detail {
 namespace {
+// A large query finds millions of pairs: in blocks, which neither copy them as they grow nor
+// hold twice their memory at a doubling, and which are freed as they are gathered.
 struct ProximityBuffer : LoopBuffers {
-  std::vector<ProximityResult::VertexFace> vf;
-  std::vector<ProximityResult::EdgeEdge> ee;
+  MappedBlocks<ProximityResult::VertexFace> vf;
+  MappedBlocks<ProximityResult::EdgeEdge> ee;
 };
 }  // namespace
 
@@ -62,17 +64,17 @@ ProximityResult SelfCore::proximity(PointsIn p, double h) {
     } unrestrict{*this};
     test_pairs(PairList(reuse.pairs), Scope::Inactive);
     reused = reuse.pairs.size();
-    test_pairs(traverse(Rule::None, Scope::Active, st, pair_locals), Scope::Active);
+    traverse_each(Rule::None, Scope::Active, st, pair_locals, false,
+                  [&](const PairList& pairs) { test_pairs(pairs, Scope::Active); });
   } else {
-    test_pairs(traverse(Rule::None, scope(), st, pair_locals), scope());
+    traverse_each(Rule::None, scope(), st, pair_locals, false,
+                  [&](const PairList& pairs) { test_pairs(pairs, scope()); });
   }
   orphan_pairs(ctx, scope(), locals, kvf, kee);
   ProximityResult res;
   res.reused_pairs = reused;
-  for (const auto& l : locals) {
-    res.vf.insert(res.vf.end(), l.vf.begin(), l.vf.end());
-    res.ee.insert(res.ee.end(), l.ee.begin(), l.ee.end());
-  }
+  drain_into(locals, &ProximityBuffer::vf, res.vf);
+  drain_into(locals, &ProximityBuffer::ee, res.ee);
   std::sort(res.vf.begin(), res.vf.end(), [](const auto& a, const auto& b) {
     return std::pair(a.vertex, a.face) < std::pair(b.vertex, b.face);
   });

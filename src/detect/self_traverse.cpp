@@ -87,6 +87,18 @@ bool SelfCore::culls(Rule mode, int i, detail::TraversalCounters& c) const {
   return ok;
 }
 
+void SelfCore::record_traversal(const detail::TraversalCounters& c, bool from_front,
+                                const PairLocals& locals, DetectStats& st) const {
+  st.box_tests = c.box_tests;
+  st.nodes_culled = c.culled;
+  st.cone_tests = c.cone_tests;
+  st.contour_tests = c.contour_tests;
+  st.contour_fails = c.contour_fails;
+  st.front_pairs = from_front ? front.size() : 0;
+  for (const auto& l : locals)
+    st.adjacent_pairs += l.adjacent;
+}
+
 detail::PairList SelfCore::traverse(Rule mode, Scope scope, DetectStats& st, PairLocals& locals,
                                     bool from_front) {
   for (PairBuffer& l : locals) {
@@ -97,26 +109,53 @@ detail::PairList SelfCore::traverse(Rule mode, Scope scope, DetectStats& st, Pai
   if (bvh.nodes().empty()) return pairs;
   const detail::TraversalCounters c =
       from_front ? traverse_front(mode, locals) : traverse_root(mode, scope, locals);
-  st.box_tests = c.box_tests;
-  st.nodes_culled = c.culled;
-  st.cone_tests = c.cone_tests;
-  st.contour_tests = c.contour_tests;
-  st.contour_fails = c.contour_fails;
-  st.front_pairs = from_front ? front.size() : 0;
-  for (const auto& l : locals) {
+  record_traversal(c, from_front, locals, st);
+  for (const auto& l : locals)
     pairs.add(l.pairs);
-    st.adjacent_pairs += l.adjacent;
-  }
   return pairs;
 }
 
-detail::TraversalCounters SelfCore::traverse_root(Rule mode, Scope scope, PairLocals& locals) {
+void SelfCore::traverse_each(Rule mode, Scope scope, DetectStats& st, PairLocals& locals,
+                             bool from_front,
+                             const std::function<void(const detail::PairList&)>& round) {
+  const std::size_t rounds = from_front ? 1 : traversal_rounds();
+  auto t = Clock::now();
+  if (rounds == 1 || bvh.nodes().empty()) {
+    const detail::PairList pairs = traverse(mode, scope, st, locals, from_front);
+    st.time_traverse = seconds_since(t);
+    round(pairs);
+    return;
+  }
+  for (PairBuffer& l : locals) {
+    l.pairs.clear();
+    l.adjacent = 0;
+  }
+  double in_rounds = 0;
+  const detail::TraversalCounters c = traverse_root(mode, scope, locals, rounds, [&] {
+    const auto t0 = Clock::now();
+    detail::PairList part;
+    for (const auto& l : locals)
+      part.add(l.pairs);
+    round(part);
+    for (PairBuffer& l : locals)
+      l.pairs.clear();
+    in_rounds += seconds_since(t0);
+  });
+  record_traversal(c, false, locals, st);
+  st.time_traverse = seconds_since(t) - in_rounds;
+}
+
+detail::TraversalCounters SelfCore::traverse_root(Rule mode, Scope scope, PairLocals& locals,
+                                                  std::size_t rounds,
+                                                  const std::function<void()>& after_round) {
   const auto& nodes = bvh.nodes();
   auto cull = [&](int i, detail::TraversalCounters& c) { return culls(mode, i, c); };
   std::span<const std::uint8_t> act;
   if (scope == Scope::Active) act = node_active;
   auto tr = detail::make_traversal(nodes, nodes, act, act, cull, leaf_step());
-  return detail::run_parallel(tr, {0, 0, true}, locals);
+  return detail::run_parallel(tr, {0, 0, true}, locals, rounds, [&] {
+    if (after_round) after_round();
+  });
 }
 
 detail::TraversalCounters SelfCore::traverse_front(Rule mode, PairLocals& locals) {

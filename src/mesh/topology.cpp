@@ -63,7 +63,7 @@ void validate_faces(std::span<const Face> faces, int num_vertices) {
 
 Topology::Topology(std::vector<Face> faces, int num_vertices)
     : num_vertices_(num_vertices), faces_(std::move(faces)) {
-  validate_faces(faces_, num_vertices_);
+  validate_faces(faces_.get(), num_vertices_);
   const int nf = num_faces();
 
   // Half-edges keyed by (larger, smaller) vertex: in that order the unique edges come out already
@@ -75,7 +75,7 @@ Topology::Topology(std::vector<Face> faces, int num_vertices)
     int id;  // 3 * face + k
   };
   std::vector<int> bucket(static_cast<std::size_t>(num_vertices_) + 1, 0);
-  for (const Face& t : faces_) {
+  for (const Face& t : faces_.get()) {
     for (int k = 0; k < 3; ++k)
       ++bucket[static_cast<std::size_t>(std::max(t[k], t[(k + 1) % 3])) + 1];
   }
@@ -85,7 +85,7 @@ Topology::Topology(std::vector<Face> faces, int num_vertices)
     std::vector<int> cursor(bucket.begin(), bucket.end() - 1);
     for (int f = 0; f < nf; ++f) {
       for (int k = 0; k < 3; ++k) {
-        const int a = faces_[f][k], b = faces_[f][(k + 1) % 3];
+        const int a = faces_.get()[f][k], b = faces_.get()[f][(k + 1) % 3];
         words[static_cast<std::size_t>(cursor[std::max(a, b)]++)] =
             static_cast<std::uint64_t>(std::min(a, b)) << 32 |
             static_cast<std::uint64_t>(3 * f + k);
@@ -138,7 +138,7 @@ Topology::Topology(std::vector<Face> faces, int num_vertices)
       num_vertices_, static_cast<std::size_t>(nf) * 3,
       [&](auto&& put) {
         for (int f = 0; f < nf; ++f) {
-          for (int v : faces_[f])
+          for (int v : faces_.get()[f])
             put(v, f);
         }
       },
@@ -161,9 +161,9 @@ Topology::Topology(std::vector<Face> faces, int num_vertices)
   // Such a face g holds f's first edge, so it is among that edge's faces, and holds f's third
   // corner too.
   for (int f = 0; f < nf; ++f) {
-    const Face& t = faces_[f];
+    const Face& t = faces_.get()[f];
     for (int g : edge_faces(face_edges_[f][0])) {
-      const Face& u = faces_[g];
+      const Face& u = faces_.get()[g];
       if (g < f && (u[0] == t[2] || u[1] == t[2] || u[2] == t[2])) {
         ++num_duplicate_faces_;
         break;
@@ -203,8 +203,8 @@ int Topology::find_edge(int a, int b) const {
 }
 
 bool Topology::faces_share_vertex(int f, int g) const {
-  for (int a : faces_[f]) {
-    for (int b : faces_[g]) {
+  for (int a : faces_.get()[f]) {
+    for (int b : faces_.get()[g]) {
       if (a == b) return true;
     }
   }
@@ -225,9 +225,9 @@ std::vector<int> Topology::face_neighbors(int f) const {
 
 std::vector<std::uint8_t> Topology::faces_touching(
     std::span<const std::uint8_t> vertex_flags) const {
-  std::vector<std::uint8_t> out(faces_.size(), 0);
-  for (std::size_t f = 0; f < faces_.size(); ++f) {
-    for (int v : faces_[f])
+  std::vector<std::uint8_t> out(faces_.get().size(), 0);
+  for (std::size_t f = 0; f < faces_.get().size(); ++f) {
+    for (int v : faces_.get()[f])
       out[f] |= vertex_flags[v];
   }
   return out;

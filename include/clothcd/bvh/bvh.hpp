@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -94,9 +95,9 @@ class Bvh {
  public:
   Bvh() = default;
   /// Builds over all faces of `topology` using the reference positions (n x 3) for the splits.
-  /// The tree keeps a copy of the faces it needs: it stays valid, and can be copied and moved,
-  /// independently of `topology`. Large subtrees are built in parallel (oneTBB); the tree is the
-  /// same for any number of threads.
+  /// The tree shares the topology's faces (Topology::shared_faces): it stays valid, and can be
+  /// copied and moved, independently of `topology`. Large subtrees are built in parallel (oneTBB);
+  /// the tree is the same for any number of threads.
   Bvh(const Topology& topology, std::span<const Eigen::Vector3d> reference, BvhBuild build);
   /// The same tree without the per-node topology flags and contours, which take about half of a
   /// build's time: for box-only traversals that rebuild their tree as the mesh deforms. Every
@@ -118,13 +119,17 @@ class Bvh {
   [[nodiscard]] int depth() const { return static_cast<int>(level_offsets_.size()) - 1; }
   /// The oriented boundary loop (vertex ids) of a disk node; empty for other nodes.
   [[nodiscard]] std::span<const int> contour(int node) const;
-  /// Normal cones of the last refit with cones, one per node. A saturated cone (one that bounds
-  /// no half-space) has a half-angle of at least pi/2: pi/2 exactly where a cone function made it
-  /// (kSaturatedHalfAngle), pi for an internal node above a saturated child. Test it with
-  /// NormalCone::saturated(), not by comparing the angle.
+  /// Normal cones of the last refit with cones, one per node (none before the first). A saturated
+  /// cone (one that bounds no half-space) has a half-angle of at least pi/2: pi/2 exactly where a
+  /// cone function made it (kSaturatedHalfAngle), pi for an internal node above a saturated child.
+  /// Test it with NormalCone::saturated(), not by comparing the angle.
   [[nodiscard]] const std::vector<NormalCone>& cones() const { return cones_; }
-  /// The faces the tree was built over (its own copy); refits read positions by these ids.
-  [[nodiscard]] const std::vector<Face>& faces() const { return faces_; }
+  /// The faces the tree was built over (shared with the topology, which never changes them);
+  /// refits read positions by these ids.
+  [[nodiscard]] const std::vector<Face>& faces() const {
+    static const std::vector<Face> none;
+    return faces_ != nullptr ? *faces_ : none;
+  }
   /// Number of vertices of the topology the tree was built from.
   [[nodiscard]] int num_vertices() const { return num_vertices_; }
   /// Sum of the internal nodes' box surface areas over the leaves', at the last refit. A tree
@@ -196,7 +201,7 @@ class Bvh {
   void build_tree(const Topology& topology, std::span<const Eigen::Vector3d> reference,
                   BvhBuild build);
 
-  std::vector<Face> faces_;
+  std::shared_ptr<const std::vector<Face>> faces_;  // Topology::shared_faces(); null: no tree
   int num_vertices_ = 0;
   std::vector<BvhNode> nodes_;
   std::vector<int> prim_ids_;

@@ -8,7 +8,9 @@
 #include <array>
 #include <cassert>
 #include <cstdint>
+#include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace clothcd {
@@ -33,10 +35,15 @@ class Topology {
   Topology(std::vector<Face> faces, int num_vertices);
 
   [[nodiscard]] int num_vertices() const { return num_vertices_; }
-  [[nodiscard]] int num_faces() const { return static_cast<int>(faces_.size()); }
+  [[nodiscard]] int num_faces() const { return static_cast<int>(faces().size()); }
   [[nodiscard]] int num_edges() const { return static_cast<int>(edges_.size()); }
 
-  [[nodiscard]] const std::vector<Face>& faces() const { return faces_; }
+  [[nodiscard]] const std::vector<Face>& faces() const { return faces_.get(); }
+  /// The same faces, shared (they never change): a tree built from this topology keeps them
+  /// without a copy of its own.
+  [[nodiscard]] const std::shared_ptr<const std::vector<Face>>& shared_faces() const {
+    return faces_.ptr();
+  }
   /// Unique undirected edges, sorted by (larger id, smaller id): the numbering of the
   /// cloth_ball candidate files.
   [[nodiscard]] const std::vector<Edge>& edges() const { return edges_; }
@@ -88,8 +95,34 @@ class Topology {
     return {ids.data() + offsets[i], static_cast<std::size_t>(offsets[i + 1] - offsets[i])};
   }
 
+  // The faces, shared with the trees built from them; never null (a moved-from topology holds
+  // an empty list, as a moved-from vector would).
+  class SharedFaces {
+   public:
+    SharedFaces() : p_(none()) {}
+    explicit SharedFaces(std::vector<Face> f)
+        : p_(std::make_shared<const std::vector<Face>>(std::move(f))) {}
+    SharedFaces(const SharedFaces&) = default;
+    SharedFaces& operator=(const SharedFaces&) = default;
+    SharedFaces(SharedFaces&& o) noexcept : p_(std::exchange(o.p_, none())) {}
+    SharedFaces& operator=(SharedFaces&& o) noexcept {
+      p_ = std::exchange(o.p_, none());
+      return *this;
+    }
+    ~SharedFaces() = default;
+    [[nodiscard]] const std::vector<Face>& get() const { return *p_; }
+    [[nodiscard]] const std::shared_ptr<const std::vector<Face>>& ptr() const { return p_; }
+
+   private:
+    static std::shared_ptr<const std::vector<Face>> none() {
+      static const auto empty = std::make_shared<const std::vector<Face>>();
+      return empty;
+    }
+    std::shared_ptr<const std::vector<Face>> p_;
+  };
+
   int num_vertices_ = 0;
-  std::vector<Face> faces_;
+  SharedFaces faces_;
   std::vector<Edge> edges_;
   std::vector<std::array<int, 3>> face_edges_;
   std::vector<int> edge_face_offsets_, edge_face_ids_;      // CSR
