@@ -1,9 +1,14 @@
 #include "ccd/refine.hpp"
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cfloat>
 #include <cmath>
 
 #include "ccd/inclusion.hpp"
 #include "ccd/motion.hpp"
+#include "clothcd/ccd/proximity.hpp"
 
 namespace clothcd::ccd_detail {
 
@@ -69,7 +74,126 @@ std::array<const Eigen::Vector3d*, 8> points_of(const EdgeEdgeQuery& q) {
   return {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0, &q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1};
 }
 
+// The largest coordinate range (extent) and the largest |coordinate| of the points.
+std::pair<double, double> extent_and_magnitude(const std::array<const Eigen::Vector3d*, 8>& p) {
+  Eigen::Vector3d lo = *p[0], hi = *p[0];
+  double m = 0;
+  for (const Eigen::Vector3d* x : p) {
+    lo = lo.cwiseMin(*x);
+    hi = hi.cwiseMax(*x);
+    m = std::max(m, x->cwiseAbs().maxCoeff());
+  }
+  return {(hi - lo).maxCoeff(), m};
+}
+
+// A query's difference corners (first[k] - second[k], each point at t0 and t1) and the
+// separation of its features at a time (the closest point of the first minus that of the second).
+template <std::size_t N, class Separation>
+struct Corners {
+  std::array<const Eigen::Vector3d*, N> a0, a1, b0, b1;
+  Separation separation;  // separation(t)
+  double need = 0;        // the distance to stay beyond, with the rounding allowance
+
+  // Whether n keeps every corner farther than `need` at lo and at hi.
+  [[nodiscard]] bool apart_along(const Eigen::Vector3d& n, double lo, double hi) const {
+    for (std::size_t k = 0; k < N; ++k) {
+      for (const double t : {lo, hi}) {
+        const Eigen::Vector3d a = *a0[k] + t * (*a1[k] - *a0[k]);
+        const Eigen::Vector3d b = *b0[k] + t * (*b1[k] - *b0[k]);
+        if (!(n.dot(a - b) > need)) return false;
+      }
+    }
+    return true;
+  }
+  // Whether one of the directions the separation gives at the middle of [lo, hi] keeps every
+  // corner apart over it; otherwise the halves, down to `depth` more levels.
+  [[nodiscard]] bool apart(double lo, double hi, int depth) const {
+    const double mid = 0.5 * (lo + hi);
+    const std::array<Eigen::Vector3d, 3> dirs = separation(mid);
+    for (const Eigen::Vector3d& d : dirs) {
+      const double len = d.norm();
+      if (len > 0 && std::isfinite(len) && apart_along(d / len, lo, hi)) return true;
+    }
+    return depth > 0 && mid > lo && mid < hi && apart(lo, mid, depth - 1) &&
+           apart(mid, hi, depth - 1);
+  }
+};
+
+// Directions to try for a separation p between features whose own directions are u and w (unit
+// or zero): p itself, which separates exactly at the exact closest points, and p without its
+// components along u and along w: where the features are nearly parallel the computed closest
+// points can slide along them, tilting p by more than the gap allows.
+std::array<Eigen::Vector3d, 3> directions(const Eigen::Vector3d& p, const Eigen::Vector3d& u,
+                                          const Eigen::Vector3d& w) {
+  return {p, p - p.dot(u) * u, p - p.dot(w) * w};
+}
+Eigen::Vector3d unit(const Eigen::Vector3d& x) {
+  const double n = x.norm();
+  return n > 0 && std::isfinite(n) ? Eigen::Vector3d(x / n) : Eigen::Vector3d::Zero();
+}
+
+// Each corner's component along n is computed with an error below 64 u max|x| (u the unit
+// roundoff: the interpolation, the difference and the dot product); the relative term covers
+// |n| != 1.
+double needed(double distance, double magnitude) {
+  return distance * (1 + 1e-12) + 128 * DBL_EPSILON * magnitude + DBL_MIN;
+}
+
+// Halvings of [0, hi] stay_apart tries: up to 2^kApartDepth directions, each a few hundred
+// instructions, against the thousands of boxes may_touch can take on such a pair.
+constexpr int kApartDepth = 5;
+
+Eigen::Vector3d at(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double t) {
+  return x0 + t * (x1 - x0);
+}
+
 }  // namespace
+
+double certified_distance(const VertexFaceQuery& q, const CcdOptions& opt) {
+  return std::sqrt(3.0) *
+         (opt.thickness + opt.tolerance * extent_and_magnitude(points_of(q)).first);
+}
+double certified_distance(const EdgeEdgeQuery& q, const CcdOptions& opt) {
+  return std::sqrt(3.0) *
+         (opt.thickness + opt.tolerance * extent_and_magnitude(points_of(q)).first);
+}
+
+bool stay_apart(const VertexFaceQuery& q, double hi, double distance) {
+  const auto separation = [&](double t) {
+    const Eigen::Vector3d v = at(q.v_t0, q.v_t1, t), f0 = at(q.f0_t0, q.f0_t1, t),
+                          f1 = at(q.f1_t0, q.f1_t1, t), f2 = at(q.f2_t0, q.f2_t1, t);
+    const Eigen::Vector3d p = v - point_triangle_proximity(v, f0, f1, f2).closest;
+    // The face's normal, towards the vertex, in place of the components along two edges.
+    Eigen::Vector3d normal = unit((f1 - f0).cross(f2 - f0));
+    if (normal.dot(p) < 0) normal = -normal;
+    return std::array<Eigen::Vector3d, 3>{p, normal,
+                                          directions(p, unit(f1 - f0), unit(f2 - f0))[2]};
+  };
+  const Corners<3, decltype(separation)> c{
+      {&q.v_t0, &q.v_t0, &q.v_t0},
+      {&q.v_t1, &q.v_t1, &q.v_t1},
+      {&q.f0_t0, &q.f1_t0, &q.f2_t0},
+      {&q.f0_t1, &q.f1_t1, &q.f2_t1},
+      separation,
+      needed(distance, extent_and_magnitude(points_of(q)).second)};
+  return c.apart(0.0, hi, kApartDepth);
+}
+bool stay_apart(const EdgeEdgeQuery& q, double hi, double distance) {
+  const auto separation = [&](double t) {
+    const Eigen::Vector3d a0 = at(q.ea0_t0, q.ea0_t1, t), a1 = at(q.ea1_t0, q.ea1_t1, t),
+                          b0 = at(q.eb0_t0, q.eb0_t1, t), b1 = at(q.eb1_t0, q.eb1_t1, t);
+    const EdgeEdgeProximity e = edge_edge_proximity(a0, a1, b0, b1);
+    return directions(e.closest_a - e.closest_b, unit(a1 - a0), unit(b1 - b0));
+  };
+  const Corners<4, decltype(separation)> c{
+      {&q.ea0_t0, &q.ea0_t0, &q.ea1_t0, &q.ea1_t0},
+      {&q.ea0_t1, &q.ea0_t1, &q.ea1_t1, &q.ea1_t1},
+      {&q.eb0_t0, &q.eb1_t0, &q.eb0_t0, &q.eb1_t0},
+      {&q.eb0_t1, &q.eb1_t1, &q.eb0_t1, &q.eb1_t1},
+      separation,
+      needed(distance, extent_and_magnitude(points_of(q)).second)};
+  return c.apart(0.0, hi, kApartDepth);
+}
 
 double refine_time_of_impact(const VertexFaceQuery& q, const CcdOptions& opt, double lo,
                              double hi) {

@@ -25,4 +25,23 @@ namespace clothcd::ccd_detail {
 [[nodiscard]] bool may_touch(const VertexFaceQuery& q, const CcdOptions& opt, double lo, double hi);
 [[nodiscard]] bool may_touch(const EdgeEdgeQuery& q, const CcdOptions& opt, double lo, double hi);
 
+/// The distance a kernel hit certifies (queries.hpp): sqrt(3) (opt.thickness + opt.tolerance L),
+/// L the query's extent (largest coordinate range of its eight points). A pair that stays farther
+/// apart than this over [lo, hi] has no hit there.
+[[nodiscard]] double certified_distance(const VertexFaceQuery& q, const CcdOptions& opt);
+[[nodiscard]] double certified_distance(const EdgeEdgeQuery& q, const CcdOptions& opt);
+
+/// true proves that the features stay farther apart than `distance` over [0, hi]: the direction n
+/// from the closest point of the second feature to that of the first at t0 separates every
+/// corner of their difference (a vertex minus a face corner, an edge end minus an edge end) by
+/// more than `distance` at t = 0 and at t = hi, with an allowance for rounding. The features'
+/// difference at any time and parameters is a combination of those corners that is linear in
+/// each parameter and in t, so its component along n is smallest at one of them. At t0 that holds
+/// for the exact closest points (they give the shortest point of a convex set); it fails, and the
+/// test says nothing, where the motion closes the gap along n within [0, hi]. Cheap (a few dot
+/// products), and it settles the near-touching pairs that slide past each other (stitched
+/// seams, resting contact), which cost may_touch's search the most.
+[[nodiscard]] bool stay_apart(const VertexFaceQuery& q, double hi, double distance);
+[[nodiscard]] bool stay_apart(const EdgeEdgeQuery& q, double hi, double distance);
+
 }  // namespace clothcd::ccd_detail

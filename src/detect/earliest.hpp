@@ -177,6 +177,7 @@ class EarliestSearch {
     // For a window's hits: a lower bound on the features' distance at t0, and the largest
     // relative displacement of their points over the step (reach()).
     double gap = 0, speed = 0;
+    double distance = 0;  // the features' distance at t0 (as computed)
   };
   // The first batch is small, so that a first time is known early; later ones are larger, so
   // that their parallel loops stay worth starting.
@@ -216,6 +217,7 @@ class EarliestSearch {
         for (const auto& [c, e] : {std::pair{&q.eb0_t0, &q.eb0_t1}, {&q.eb1_t0, &q.eb1_t1}})
           h.speed = std::max(h.speed, ((*b - *a) - (*e - *c)).norm());
     }
+    h.distance = d;
     const double gap = std::max(0.0, d - kernel_.thickness);
     h.toi = gap == 0 ? 0.0 : h.speed > 0 ? gap / h.speed : INFINITY;
   }
@@ -242,7 +244,21 @@ class EarliestSearch {
     }
     if (best != nullptr && !can_touch(h, cap)) return 2.0;
     const auto one = [&](const auto& q) {
-      if (best != nullptr && !ccd_detail::may_touch(q, kernel_, 0.0, cap)) return 2.0;
+      // The separating direction first (a few dot products), then the search: over may_touch's
+      // interval (cap rounded up to the kernel's time grid) and beyond the distance a kernel hit
+      // certifies, so that a pair it drops is one without a hit by cap.
+      if (best != nullptr &&
+          ccd_detail::stay_apart(q, std::min(1.0, cap + 2 * kernel_.toi_tolerance),
+                                 ccd_detail::certified_distance(q, kernel_))) {
+        return 2.0;
+      }
+      // A pair already within that distance at t0 keeps the search looking for long before it
+      // finds the box it cannot reject (on a stitched seam, thousands of them): the kernel times
+      // it at once.
+      if (best != nullptr && !(h.distance <= ccd_detail::certified_distance(q, kernel_)) &&
+          !ccd_detail::may_touch(q, kernel_, 0.0, cap)) {
+        return 2.0;
+      }
       CcdResult k;
       if constexpr (std::is_same_v<std::decay_t<decltype(q)>, VertexFaceQuery>) {
         k = vertex_face_ccd(q, kernel_);
