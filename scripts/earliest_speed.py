@@ -14,7 +14,8 @@ Usage: scripts/earliest_speed.py [--bin BIN] [--reps N] [--slow-reps N] [--repea
   docs/results/earliest.md. Data: $CLOTHCD_DATA or ../shared/data. --frames: the frames folder
   of a `scripts/results.sh OUT` run (or any folder of <scene>/frame_NNNN.obj): adds the
   simulated garment steps dress-rumba and multilayer-rumba 60 -> 61 (sewn at 1e-3, patch
-  build), at zero thickness and at 1e-3.
+  build), at zero thickness and at 1e-3, and the same steps unsewn at zero thickness (their
+  seams' edges nearly touching).
 """
 
 import argparse
@@ -47,6 +48,9 @@ def cases(frames):
         args = ["--t0", str(f0), "--t1", str(f1), "--sew", "1e-3", "--bvh", "patch"]
         for h in (0.0, 1e-3):
             out.append((f"{scene} {k} -> {k + 1}", h, args))
+        # The same step with the seams left as the frames have them: the stitched panels' edges
+        # a fraction of a micrometre apart, sliding along each other (near-touching pairs).
+        out.append((f"{scene} {k} -> {k + 1}, seams unsewn", 0.0, args[:4] + ["--bvh", "patch"]))
     return out
 
 
