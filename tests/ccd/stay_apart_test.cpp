@@ -213,7 +213,35 @@ TEST(StayApart, NeverClearsPairsThatClose) {
       EXPECT_FALSE(ccd_detail::stay_apart(f, 1.0, 0.0));
     }
   }
-  EXPECT_GT(touching, 20);
+  // And pairs made to pass through each other: an edge crossing another, a vertex crossing a
+  // face's interior, at random times of the step.
+  std::uniform_real_distribution<double> w(0.2, 0.8), n(-0.05, 0.05);
+  for (int i = 0; i < 40; ++i) {
+    const double z = w(rng);  // the crossing at t = z
+    EdgeEdgeQuery e;
+    e.ea0_t0 = e.ea0_t1 = V(0, n(rng), n(rng));
+    e.ea1_t0 = e.ea1_t1 = V(1, n(rng), n(rng));
+    e.eb0_t0 = V(w(rng), -0.5, z);
+    e.eb1_t0 = V(w(rng), 0.5, z);
+    e.eb0_t1 = e.eb0_t0 - V(0, 0, 1);
+    e.eb1_t1 = e.eb1_t0 - V(0, 0, 1);
+    VertexFaceQuery f;
+    f.f0_t0 = f.f0_t1 = V(0, 0, n(rng));
+    f.f1_t0 = f.f1_t1 = V(1, 0, n(rng));
+    f.f2_t0 = f.f2_t1 = V(0, 1, n(rng));
+    f.v_t0 = V(0.25, 0.25, z);
+    f.v_t1 = f.v_t0 - V(0, 0, 1);
+    ASSERT_TRUE(test::exact_edge_edge_contact(e));
+    ASSERT_TRUE(test::exact_vertex_face_contact(f));
+    touching += 2;
+    for (const double hi : {1.0, std::min(1.0, z + 0.1)}) {
+      ASSERT_TRUE(test::exact_edge_edge_contact(e, hi));
+      ASSERT_TRUE(test::exact_vertex_face_contact(f, hi));
+      EXPECT_FALSE(ccd_detail::stay_apart(e, hi, 0.0));
+      EXPECT_FALSE(ccd_detail::stay_apart(f, hi, 0.0));
+    }
+  }
+  EXPECT_GT(touching, 80);
   // A pair touching at t0 is never cleared.
   EdgeEdgeQuery start = seam_pair(rng, 0.0, 1e-6, 1e-3);
   start.eb0_t0 = start.ea0_t0;
