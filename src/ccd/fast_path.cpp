@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "ccd/certify.hpp"
+#include "ccd/refine.hpp"
 
 namespace clothcd::ccd_detail {
 
@@ -118,7 +119,7 @@ FastOutcome fast_path_solve(Kind kind, const Motion& m, const BernsteinCubic& c,
   search(kind, m, c, toi_target_level(p.toi_tolerance), kMaxLevel, out, [&](double lo, double hi) {
     q.t_lo = lo;
     q.t_hi = hi;
-    const InclusionOutcome o = inclusion_solve(kind, m, q);
+    const InclusionOutcome o = bounded_inclusion_solve(kind, m, q);
     out.boxes += o.boxes;
     if (o.hit) {
       out.hit = true;

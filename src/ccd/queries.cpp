@@ -17,6 +17,7 @@
 #include "ccd/inclusion.hpp"
 #include "ccd/motion.hpp"
 #include "ccd/np_batch.hpp"
+#include "ccd/refine.hpp"
 
 namespace clothcd {
 
@@ -95,7 +96,7 @@ CcdResult run(Kind kind, const std::array<const Eigen::Vector3d*, 8>& points, co
     r.boxes = o.boxes;
     return r;
   }
-  const auto o = ccd_detail::inclusion_solve(kind, m, p);
+  const auto o = ccd_detail::bounded_inclusion_solve(kind, m, p);
   return from(o, CcdPath::Inclusion, o.boxes);
 }
 

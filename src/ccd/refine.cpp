@@ -39,7 +39,7 @@ struct Search {
     if (trivial) return true;
     p.t_lo = lo;
     p.t_hi = hi;
-    return inclusion_solve(kind, m, p).hit;
+    return bounded_inclusion_solve(kind, m, p).hit;
   }
 };
 
@@ -143,8 +143,48 @@ double needed(double distance, double magnitude) {
 // instructions, against the thousands of boxes may_touch can take on such a pair.
 constexpr int kApartDepth = 5;
 
+// The boxes a search may take before stay_apart is tried on its range (bounded_inclusion_solve):
+// most searches end within a few dozen; those that run on are mostly tiling the near-contact set
+// of two nearly parallel features.
+constexpr std::uint32_t kQuickBoxes = 1024;
+
 Eigen::Vector3d at(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double t) {
   return x0 + t * (x1 - x0);
+}
+
+// stay_apart over [lo, hi] on a query's points in points_of's order.
+bool apart_over(Kind kind, const std::array<const Eigen::Vector3d*, 8>& x, double lo, double hi,
+                double distance) {
+  const double need = needed(distance, extent_and_magnitude(x).second);
+  if (kind == Kind::VertexFace) {
+    const auto separation = [&](double t) {
+      const Eigen::Vector3d v = at(*x[0], *x[4], t), f0 = at(*x[1], *x[5], t),
+                            f1 = at(*x[2], *x[6], t), f2 = at(*x[3], *x[7], t);
+      const Eigen::Vector3d p = v - point_triangle_proximity(v, f0, f1, f2).closest;
+      // The face's normal, towards the vertex, in place of the components along two edges.
+      Eigen::Vector3d normal = unit((f1 - f0).cross(f2 - f0));
+      if (normal.dot(p) < 0) normal = -normal;
+      return std::array<Eigen::Vector3d, 3>{p, normal,
+                                            directions(p, unit(f1 - f0), unit(f2 - f0))[2]};
+    };
+    const Corners<3, decltype(separation)> c{{x[0], x[0], x[0]}, {x[4], x[4], x[4]},
+                                             {x[1], x[2], x[3]}, {x[5], x[6], x[7]},
+                                             separation,         need};
+    return c.apart(lo, hi, kApartDepth);
+  }
+  const auto separation = [&](double t) {
+    const Eigen::Vector3d a0 = at(*x[0], *x[4], t), a1 = at(*x[1], *x[5], t),
+                          b0 = at(*x[2], *x[6], t), b1 = at(*x[3], *x[7], t);
+    const EdgeEdgeProximity e = edge_edge_proximity(a0, a1, b0, b1);
+    return directions(e.closest_a - e.closest_b, unit(a1 - a0), unit(b1 - b0));
+  };
+  const Corners<4, decltype(separation)> c{{x[0], x[0], x[1], x[1]},
+                                           {x[4], x[4], x[5], x[5]},
+                                           {x[2], x[3], x[2], x[3]},
+                                           {x[6], x[7], x[6], x[7]},
+                                           separation,
+                                           need};
+  return c.apart(lo, hi, kApartDepth);
 }
 
 }  // namespace
@@ -159,40 +199,37 @@ double certified_distance(const EdgeEdgeQuery& q, const CcdOptions& opt) {
 }
 
 bool stay_apart(const VertexFaceQuery& q, double hi, double distance) {
-  const auto separation = [&](double t) {
-    const Eigen::Vector3d v = at(q.v_t0, q.v_t1, t), f0 = at(q.f0_t0, q.f0_t1, t),
-                          f1 = at(q.f1_t0, q.f1_t1, t), f2 = at(q.f2_t0, q.f2_t1, t);
-    const Eigen::Vector3d p = v - point_triangle_proximity(v, f0, f1, f2).closest;
-    // The face's normal, towards the vertex, in place of the components along two edges.
-    Eigen::Vector3d normal = unit((f1 - f0).cross(f2 - f0));
-    if (normal.dot(p) < 0) normal = -normal;
-    return std::array<Eigen::Vector3d, 3>{p, normal,
-                                          directions(p, unit(f1 - f0), unit(f2 - f0))[2]};
-  };
-  const Corners<3, decltype(separation)> c{
-      {&q.v_t0, &q.v_t0, &q.v_t0},
-      {&q.v_t1, &q.v_t1, &q.v_t1},
-      {&q.f0_t0, &q.f1_t0, &q.f2_t0},
-      {&q.f0_t1, &q.f1_t1, &q.f2_t1},
-      separation,
-      needed(distance, extent_and_magnitude(points_of(q)).second)};
-  return c.apart(0.0, hi, kApartDepth);
+  return apart_over(Kind::VertexFace, points_of(q), 0.0, hi, distance);
 }
 bool stay_apart(const EdgeEdgeQuery& q, double hi, double distance) {
-  const auto separation = [&](double t) {
-    const Eigen::Vector3d a0 = at(q.ea0_t0, q.ea0_t1, t), a1 = at(q.ea1_t0, q.ea1_t1, t),
-                          b0 = at(q.eb0_t0, q.eb0_t1, t), b1 = at(q.eb1_t0, q.eb1_t1, t);
-    const EdgeEdgeProximity e = edge_edge_proximity(a0, a1, b0, b1);
-    return directions(e.closest_a - e.closest_b, unit(a1 - a0), unit(b1 - b0));
-  };
-  const Corners<4, decltype(separation)> c{
-      {&q.ea0_t0, &q.ea0_t0, &q.ea1_t0, &q.ea1_t0},
-      {&q.ea0_t1, &q.ea0_t1, &q.ea1_t1, &q.ea1_t1},
-      {&q.eb0_t0, &q.eb1_t0, &q.eb0_t0, &q.eb1_t0},
-      {&q.eb0_t1, &q.eb1_t1, &q.eb0_t1, &q.eb1_t1},
-      separation,
-      needed(distance, extent_and_magnitude(points_of(q)).second)};
-  return c.apart(0.0, hi, kApartDepth);
+  return apart_over(Kind::EdgeEdge, points_of(q), 0.0, hi, distance);
+}
+
+InclusionOutcome bounded_inclusion_solve(Kind kind, const Motion& m, const InclusionParams& p) {
+  if (p.max_boxes <= kQuickBoxes) return inclusion_solve(kind, m, p);
+  InclusionParams quick = p;
+  quick.max_boxes = kQuickBoxes;
+  // The same search as with the whole budget while it stays within the quick one.
+  const InclusionOutcome first = inclusion_solve(kind, m, quick);
+  if (first.boxes <= kQuickBoxes) return first;
+  // A box the solver reports as a hit is narrower than its tolerance on every axis and overlaps
+  // the thickness there, so its points are within sqrt(3) (thickness + tolerance + rounding): a
+  // pair proven farther apart than that over the range has no hit in it.
+  double err = 0;
+  for (int a = 0; a < 3; ++a)
+    err = std::max(err, corner_error_bound(m.max_abs[a]));
+  const double reach =
+      std::sqrt(3.0) * (p.thickness + 3 * err + std::max(p.tolerance, 16 * err)) * (1 + 1e-9);
+  const std::array<const Eigen::Vector3d*, 8> x = {&m.x0[0], &m.x0[1], &m.x0[2], &m.x0[3],
+                                                   &m.x1[0], &m.x1[1], &m.x1[2], &m.x1[3]};
+  if (apart_over(kind, x, p.t_lo, p.t_hi, reach)) {
+    InclusionOutcome none;
+    none.boxes = first.boxes;
+    return none;
+  }
+  InclusionOutcome whole = inclusion_solve(kind, m, p);
+  whole.boxes += first.boxes;
+  return whole;
 }
 
 double refine_time_of_impact(const VertexFaceQuery& q, const CcdOptions& opt, double lo,

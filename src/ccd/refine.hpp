@@ -5,6 +5,7 @@
 // makes that region wide. Here each step only asks whether [lo, mid] holds a box the inclusion
 // solver cannot reject: the first such box answers yes, a full rejection answers no.
 
+#include "ccd/inclusion.hpp"
 #include "clothcd/ccd/queries.hpp"
 
 namespace clothcd::ccd_detail {
@@ -43,5 +44,14 @@ namespace clothcd::ccd_detail {
 /// seams, resting contact), which cost may_touch's search the most.
 [[nodiscard]] bool stay_apart(const VertexFaceQuery& q, double hi, double distance);
 [[nodiscard]] bool stay_apart(const EdgeEdgeQuery& q, double hi, double distance);
+
+/// inclusion_solve(kind, m, p) with a way out for the searches that run long: past a quick budget
+/// of boxes, stay_apart on p's time range (at the distance a hit box certifies); a pair proven
+/// apart has no hit, and any other goes on with the whole budget from the start. The same
+/// outcome as inclusion_solve wherever that finds a hit box or rejects every box; where its
+/// budget would run out (reporting its earliest open time as a hit), a pair proven apart is no
+/// hit instead. `boxes` counts every box examined.
+[[nodiscard]] InclusionOutcome bounded_inclusion_solve(Kind kind, const Motion& m,
+                                                       const InclusionParams& p);
 
 }  // namespace clothcd::ccd_detail

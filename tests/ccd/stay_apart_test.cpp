@@ -12,6 +12,8 @@
 #include <cmath>
 #include <random>
 
+#include "ccd/inclusion.hpp"
+#include "ccd/motion.hpp"
 #include "ccd/refine.hpp"
 #include "clothcd/ccd/proximity.hpp"
 #include "exact_oracle.hpp"
@@ -247,6 +249,51 @@ TEST(StayApart, NeverClearsPairsThatClose) {
   start.eb0_t0 = start.ea0_t0;
   EXPECT_FALSE(ccd_detail::stay_apart(start, 1.0, 0.0));
   EXPECT_GT(c.cleared, 0);
+}
+
+// The inclusion solver's settings for a query at zero thickness, as the kernels set them.
+ccd_detail::InclusionParams solver_params(const ccd_detail::Motion& m) {
+  const CcdOptions o;
+  ccd_detail::InclusionParams p;
+  p.tolerance = o.tolerance * m.extent;
+  p.toi_tolerance = o.toi_tolerance;
+  p.max_boxes = o.max_boxes;
+  return p;
+}
+
+TEST(StayApart, BoundedSearchesEndWhereTheWholeBudgetWouldRunOut) {
+  // Seam pairs 40-400 nm apart sliding along each other (and drifting across by up to 10 um):
+  // the plain search tiles their near-contact line until its budget runs out and reports a hit;
+  // the bounded one proves many of them apart (each checked by the exact oracle) and otherwise
+  // gives the plain search's answer. Wherever the plain search ends within its budget, both give
+  // the same outcome.
+  std::mt19937 rng(5);
+  int exhausted = 0, settled = 0;
+  for (int i = 0; i < 60; ++i) {
+    const EdgeEdgeQuery q = seam_pair(rng, 4e-8 * (1 + i % 10), i % 2 == 0 ? 0.0 : 1e-6, 1e-3);
+    const std::array<const V*, 8> x = {&q.ea0_t0, &q.ea1_t0, &q.eb0_t0, &q.eb1_t0,
+                                       &q.ea0_t1, &q.ea1_t1, &q.eb0_t1, &q.eb1_t1};
+    const ccd_detail::Motion m = ccd_detail::make_motion(x);
+    const ccd_detail::InclusionParams p = solver_params(m);
+    const ccd_detail::InclusionOutcome plain =
+        ccd_detail::inclusion_solve(ccd_detail::Kind::EdgeEdge, m, p);
+    const ccd_detail::InclusionOutcome bounded =
+        ccd_detail::bounded_inclusion_solve(ccd_detail::Kind::EdgeEdge, m, p);
+    if (plain.boxes > p.max_boxes) {
+      ++exhausted;
+      if (!bounded.hit) {
+        ++settled;
+        EXPECT_FALSE(test::exact_edge_edge_contact(q));
+      } else {  // not proven apart: the whole search ran again, with its own answer
+        EXPECT_EQ(bounded.toi, plain.toi);
+      }
+    } else {
+      EXPECT_EQ(bounded.hit, plain.hit);
+      EXPECT_EQ(bounded.toi, plain.toi);
+    }
+  }
+  EXPECT_GT(exhausted, 0);
+  EXPECT_GE(settled, 10) << settled << " of " << exhausted;
 }
 
 TEST(StayApart, CertifiedDistanceIsTheKernelsBound) {

@@ -43,7 +43,8 @@ struct CcdOptions {
   /// (always on the early side). 0 refines it fully, which costs more on colliding queries.
   double toi_tolerance = 1e-4;
   /// Boxes the inclusion solver may visit per query; past it the query is reported as a hit with
-  /// the earliest time still open (conservative, bounded time).
+  /// the earliest time still open (conservative, bounded time), unless a separating direction
+  /// proves the features apart over the search's time range (docs/ccd.md).
   std::uint32_t max_boxes = 1u << 16;
 };
 
