@@ -43,7 +43,11 @@ STAGES = [
     ("refit (boxes and cones)", 2, [r"clothcd::detail::SelfCore::refit\("]),
     ("traversal (box and cone tests, triangle pairs)", 2,
      [r"clothcd::detail::SelfCore::traverse\("]),
-    ("narrow phase", 2, [r"clothcd::detail::SelfCore::narrow\("]),
+    # The pair loop over each round of the traversal's pairs, the orphans, and the step's
+    # feature boxes (brought up to date before the first round, timed as narrow phase).
+    ("narrow phase", 2, [r"clothcd::detail::SelfCore::narrow_pairs\(",
+                         r"clothcd::detail::SelfCore::narrow_orphans\(",
+                         r"clothcd::detail::FeatureBoxes::update\("]),
     ("whole-triangle distance filter (vectorised)", 3,
      [r"clothcd::ccd_detail::triangles_filter_batch\("]),
     ("NP filter (vectorised)", 3, [r"clothcd::ccd_detail::np_filter_batch\("]),
