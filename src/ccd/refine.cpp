@@ -148,6 +148,15 @@ constexpr int kApartDepth = 5;
 // of two nearly parallel features.
 constexpr std::uint32_t kQuickBoxes = 1024;
 
+// The distance within which a box the inclusion solver reports as a hit lies: the box is
+// narrower than the tolerance on every axis (or than 16 err, below which the rounding noise
+// keeps it) and overlaps the thickness, each computed corner value within err of the exact one.
+// `tolerance` absolute, err from the largest |coordinate|, all in one unit (scaled or not).
+double hit_reach(double thickness, double tolerance, double max_abs) {
+  const double err = corner_error_bound(max_abs);
+  return std::sqrt(3.0) * (thickness + 3 * err + std::max(tolerance, 16 * err)) * (1 + 1e-9);
+}
+
 Eigen::Vector3d at(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1, double t) {
   return x0 + t * (x1 - x0);
 }
@@ -190,12 +199,12 @@ bool apart_over(Kind kind, const std::array<const Eigen::Vector3d*, 8>& x, doubl
 }  // namespace
 
 double certified_distance(const VertexFaceQuery& q, const CcdOptions& opt) {
-  return std::sqrt(3.0) *
-         (opt.thickness + opt.tolerance * extent_and_magnitude(points_of(q)).first);
+  const auto [extent, magnitude] = extent_and_magnitude(points_of(q));
+  return hit_reach(opt.thickness, opt.tolerance * extent, magnitude);
 }
 double certified_distance(const EdgeEdgeQuery& q, const CcdOptions& opt) {
-  return std::sqrt(3.0) *
-         (opt.thickness + opt.tolerance * extent_and_magnitude(points_of(q)).first);
+  const auto [extent, magnitude] = extent_and_magnitude(points_of(q));
+  return hit_reach(opt.thickness, opt.tolerance * extent, magnitude);
 }
 
 bool stay_apart(const VertexFaceQuery& q, double hi, double distance) {
@@ -212,14 +221,8 @@ InclusionOutcome bounded_inclusion_solve(Kind kind, const Motion& m, const Inclu
   // The same search as with the whole budget while it stays within the quick one.
   const InclusionOutcome first = inclusion_solve(kind, m, quick);
   if (first.boxes <= kQuickBoxes) return first;
-  // A box the solver reports as a hit is narrower than its tolerance on every axis and overlaps
-  // the thickness there, so its points are within sqrt(3) (thickness + tolerance + rounding): a
-  // pair proven farther apart than that over the range has no hit in it.
-  double err = 0;
-  for (int a = 0; a < 3; ++a)
-    err = std::max(err, corner_error_bound(m.max_abs[a]));
-  const double reach =
-      std::sqrt(3.0) * (p.thickness + 3 * err + std::max(p.tolerance, 16 * err)) * (1 + 1e-9);
+  // A pair proven farther apart than a hit box can be over the range has no hit in it.
+  const double reach = hit_reach(p.thickness, p.tolerance, m.max_abs.maxCoeff());
   const std::array<const Eigen::Vector3d*, 8> x = {&m.x0[0], &m.x0[1], &m.x0[2], &m.x0[3],
                                                    &m.x1[0], &m.x1[1], &m.x1[2], &m.x1[3]};
   if (apart_over(kind, x, p.t_lo, p.t_hi, reach)) {

@@ -27,8 +27,9 @@ namespace clothcd::ccd_detail {
 [[nodiscard]] bool may_touch(const EdgeEdgeQuery& q, const CcdOptions& opt, double lo, double hi);
 
 /// The distance a kernel hit certifies (queries.hpp): sqrt(3) (opt.thickness + opt.tolerance L),
-/// L the query's extent (largest coordinate range of its eight points). A pair that stays farther
-/// apart than this over [lo, hi] has no hit there.
+/// L the query's extent (largest coordinate range of its eight points), widened by the solver's
+/// rounding bound (the same reach bounded_inclusion_solve uses). A pair that stays farther apart
+/// than this over [lo, hi] has no hit there.
 [[nodiscard]] double certified_distance(const VertexFaceQuery& q, const CcdOptions& opt);
 [[nodiscard]] double certified_distance(const EdgeEdgeQuery& q, const CcdOptions& opt);
 

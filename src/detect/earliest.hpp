@@ -244,20 +244,20 @@ class EarliestSearch {
     }
     if (best != nullptr && !can_touch(h, cap)) return 2.0;
     const auto one = [&](const auto& q) {
-      // The separating direction first (a few dot products), then the search: over may_touch's
-      // interval (cap rounded up to the kernel's time grid) and beyond the distance a kernel hit
-      // certifies, so that a pair it drops is one without a hit by cap.
-      if (best != nullptr &&
-          ccd_detail::stay_apart(q, std::min(1.0, cap + 2 * kernel_.toi_tolerance),
-                                 ccd_detail::certified_distance(q, kernel_))) {
-        return 2.0;
-      }
-      // A pair already within that distance at t0 keeps the search looking for long before it
-      // finds the box it cannot reject (on a stitched seam, thousands of them): the kernel times
-      // it at once.
-      if (best != nullptr && !(h.distance <= ccd_detail::certified_distance(q, kernel_)) &&
-          !ccd_detail::may_touch(q, kernel_, 0.0, cap)) {
-        return 2.0;
+      if (best != nullptr) {
+        // The separating direction first (a few dot products; may_touch's search tries it too,
+        // but only after its first 1,024 boxes: on dress-rumba 60 -> 61 unsewn the query takes
+        // 114 M instructions with this call, 191 M without), then the search: over may_touch's
+        // interval (cap rounded up to the kernel's time grid) and beyond the distance a kernel
+        // hit certifies, so that a pair it drops is one without a hit by cap.
+        const double reach = ccd_detail::certified_distance(q, kernel_);
+        if (ccd_detail::stay_apart(q, std::min(1.0, cap + 2 * kernel_.toi_tolerance), reach)) {
+          return 2.0;
+        }
+        // A pair already within that distance at t0 keeps the search looking for long before it
+        // finds the box it cannot reject (on a stitched seam, thousands of them): the kernel
+        // times it at once.
+        if (!(h.distance <= reach) && !ccd_detail::may_touch(q, kernel_, 0.0, cap)) return 2.0;
       }
       CcdResult k;
       if constexpr (std::is_same_v<std::decay_t<decltype(q)>, VertexFaceQuery>) {
