@@ -3,8 +3,9 @@
 // (58,687 triangles), the garment prefix of their drape.obj, over one step to a smooth
 // perturbation of the drape (amplitude 1 cm, wavelength 0.2 m, seed 1: `clothcd detect
 // --perturb 0.01`). Arguments: garment (0 dress, 1 multilayer), build (0 spatial, 1 patch),
-// threads. Also the PROPOSED refit of the same tree, for scale. Skips when the shared data is
-// absent.
+// threads. Also the PROPOSED refit of the same tree, for scale, and the refit a CCD pass runs
+// (boxes only, or boxes and cones from the simulator's 16-triangle floor or on every node): what
+// the cones add to a pass. Skips when the shared data is absent.
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
@@ -92,6 +93,37 @@ void BM_ProposedRefit(benchmark::State& state) {
   refit_bench(state, false);
 }
 
+// The product refit a CCD pass runs: boxes only (culling none), or boxes and PROPOSED cones
+// from `min_triangles` triangles up (16: the simulator's sound culling; 0: every node).
+void product_refit_bench(benchmark::State& state, bool cones, int min_triangles) {
+  const Garment* g = garment(static_cast<int>(state.range(0)));
+  if (g == nullptr) {
+    state.SkipWithError("garments not found (set CLOTHCD_DATA)");
+    return;
+  }
+  tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
+                              static_cast<std::size_t>(state.range(2)));
+  Bvh bvh(*g->topology, g->v0, state.range(1) == 0 ? BvhBuild::Spatial : BvhBuild::Patch);
+  RefitOptions o;
+  o.cones = cones;
+  o.cone_min_triangles = min_triangles;
+  for (auto _ : state) {
+    bvh.refit(g->v0, g->v1, o);
+    benchmark::DoNotOptimize(bvh.nodes().data());
+  }
+  state.counters["triangles"] = g->topology->num_faces();
+}
+
+void BM_BoxRefit(benchmark::State& state) {
+  product_refit_bench(state, false, 0);
+}
+void BM_ConeRefit16(benchmark::State& state) {
+  product_refit_bench(state, true, 16);
+}
+void BM_ConeRefitAll(benchmark::State& state) {
+  product_refit_bench(state, true, 0);
+}
+
 void args(benchmark::internal::Benchmark* b) {
   for (int garment : {0, 1}) {
     for (int build : {0, 1}) {
@@ -106,4 +138,7 @@ void args(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_OptimalRefit)->Name("optimal_refit")->Apply(args);
 BENCHMARK(BM_ProposedRefit)->Name("proposed_refit")->Apply(args);
+BENCHMARK(BM_BoxRefit)->Name("box_refit")->Apply(args);
+BENCHMARK(BM_ConeRefit16)->Name("cone_refit_min16")->Apply(args);
+BENCHMARK(BM_ConeRefitAll)->Name("cone_refit_all")->Apply(args);
 BENCHMARK_MAIN();
