@@ -19,8 +19,8 @@ namespace clothcd::ccd_detail {
 namespace NP_BATCH_NAMESPACE {
 namespace distance {
 
-using lanes::max_of;
-using lanes::min_of;
+using simd::lanes::max_of;
+using simd::lanes::min_of;
 
 // p + s (q - p), coordinate by coordinate (Eigen's p + s * (q - p)).
 template <class B>

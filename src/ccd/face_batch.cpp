@@ -1,12 +1,12 @@
 // The batched whole-triangle filters: the widest body the processor runs (face_batch_*.cpp), or
-// the scalar filter pair by pair without xsimd or off x86-64 (CLOTHCD_NP_BATCH_X86 unset).
+// the scalar filter pair by pair without xsimd or off x86-64 (CLOTHCD_SIMD_X86 unset).
 #include "ccd/face_batch.hpp"
 
-#include "ccd/isa.hpp"
+#include "core/isa.hpp"
 
 namespace clothcd::ccd_detail {
 
-#if CLOTHCD_NP_BATCH_X86
+#if CLOTHCD_SIMD_X86
 void triangles_filter_batch_sse2(const FacePairBatch& b, double thickness, bool* culls,
                                  double* bound_t1);
 void triangles_filter_batch_avx2(const FacePairBatch& b, double thickness, bool* culls,
@@ -41,7 +41,7 @@ void triangle_bound_batch_scalar(const StaticFacePairBatch& b, double* bound) {
   }
 }
 
-#if CLOTHCD_NP_BATCH_X86
+#if CLOTHCD_SIMD_X86
 constexpr void (*const kFilter[4])(const FacePairBatch&, double, bool*, double*) = {
     triangles_filter_batch_scalar, triangles_filter_batch_sse2, triangles_filter_batch_avx2,
     triangles_filter_batch_avx512};
@@ -59,20 +59,20 @@ constexpr void (*const kBound[4])(const StaticFacePairBatch&, double*) = {
 
 void triangles_filter_batch(const FacePairBatch& b, double thickness, bool* culls,
                             double* bound_t1) {
-  run_on(-1, kFilter, b, thickness, culls, bound_t1);
+  simd::run_on(-1, kFilter, b, thickness, culls, bound_t1);
 }
 
 bool triangles_filter_batch_with(int isa, const FacePairBatch& b, double thickness, bool* culls,
                                  double* bound_t1) {
-  return isa >= 0 && run_on(isa, kFilter, b, thickness, culls, bound_t1);
+  return isa >= 0 && simd::run_on(isa, kFilter, b, thickness, culls, bound_t1);
 }
 
 void triangle_bound_batch(const StaticFacePairBatch& b, double* bound) {
-  run_on(-1, kBound, b, bound);
+  simd::run_on(-1, kBound, b, bound);
 }
 
 bool triangle_bound_batch_with(int isa, const StaticFacePairBatch& b, double* bound) {
-  return isa >= 0 && run_on(isa, kBound, b, bound);
+  return isa >= 0 && simd::run_on(isa, kBound, b, bound);
 }
 
 }  // namespace clothcd::ccd_detail

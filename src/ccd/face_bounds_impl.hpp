@@ -11,20 +11,20 @@
 
 #include <cmath>
 
-#include "ccd/lanes.hpp"
+#include "core/lanes.hpp"
 
 namespace clothcd::ccd_detail {
 namespace FACE_BOUNDS_NAMESPACE {
 
 // The 3-vector of lanes and its operations (lanes.hpp).
 template <class T>
-using P3 = lanes::Vec3<T>;
-using lanes::cross;
-using lanes::dot;
-using lanes::max_of;
-using lanes::min_of;
-using lanes::select;
-using lanes::sub;
+using P3 = simd::lanes::Vec3<T>;
+using simd::lanes::cross;
+using simd::lanes::dot;
+using simd::lanes::max_of;
+using simd::lanes::min_of;
+using simd::lanes::select;
+using simd::lanes::sub;
 
 template <class T>
 P3<T> min_of(const P3<T>& p, const P3<T>& q) {

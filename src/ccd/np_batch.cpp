@@ -2,14 +2,14 @@
 
 #include "ccd/certify.hpp"
 #include "ccd/fast_path.hpp"
-#include "ccd/isa.hpp"
 #include "clothcd/ccd/queries.hpp"
+#include "core/isa.hpp"
 
-// Without xsimd or off x86-64 (CLOTHCD_NP_BATCH_X86 unset) the batch runs the scalar filter.
+// Without xsimd or off x86-64 (CLOTHCD_SIMD_X86 unset) the batch runs the scalar filter.
 
 namespace clothcd::ccd_detail {
 
-#if CLOTHCD_NP_BATCH_X86
+#if CLOTHCD_SIMD_X86
 void np_filter_batch_sse2(Kind kind, const NpBatch& b, NpVerdict* verdict);
 void np_filter_batch_avx2(Kind kind, const NpBatch& b, NpVerdict* verdict);
 void fast_path_settle_sse2(Kind kind, const NpBatch& b, const NpVerdict* verdict, int target,
@@ -91,7 +91,7 @@ void settle_batch_scalar(Kind kind, const NpBatch& b, const NpVerdict* verdict, 
   }
 }
 
-#if CLOTHCD_NP_BATCH_X86
+#if CLOTHCD_SIMD_X86
 constexpr void (*const kNp[4])(Kind, const NpBatch&, NpVerdict*) = {
     np_filter_batch_scalar, np_filter_batch_sse2, np_filter_batch_avx2, np_filter_batch_avx512};
 constexpr void (*const kSettle[4])(Kind, const NpBatch&, const NpVerdict*, int, FastSettled*,
@@ -112,36 +112,36 @@ constexpr void (*const kDistance[4])(Kind, const NpBatch&, double, int, NpVerdic
 }  // namespace
 
 void np_filter_batch(Kind kind, const NpBatch& b, NpVerdict* verdict) {
-  run_on(-1, kNp, kind, b, verdict);
+  simd::run_on(-1, kNp, kind, b, verdict);
 }
 
 void fast_path_settle(Kind kind, const NpBatch& b, const NpVerdict* verdict, double toi_tolerance,
                       FastSettled* settled, double* toi) {
-  run_on(-1, kSettle, kind, b, verdict, toi_target_level(toi_tolerance), settled, toi);
+  simd::run_on(-1, kSettle, kind, b, verdict, toi_target_level(toi_tolerance), settled, toi);
 }
 
 bool fast_path_settle_with(int isa, Kind kind, const NpBatch& b, const NpVerdict* verdict,
                            double toi_tolerance, FastSettled* settled, double* toi) {
-  return isa >= 0 &&
-         run_on(isa, kSettle, kind, b, verdict, toi_target_level(toi_tolerance), settled, toi);
+  return isa >= 0 && simd::run_on(isa, kSettle, kind, b, verdict, toi_target_level(toi_tolerance),
+                                  settled, toi);
 }
 
 void distance_filter_batch(Kind kind, const NpBatch& b, double thickness, int depth,
                            NpVerdict* verdict) {
-  run_on(-1, kDistance, kind, b, thickness, depth, verdict);
+  simd::run_on(-1, kDistance, kind, b, thickness, depth, verdict);
 }
 
 bool distance_filter_batch_with(int isa, Kind kind, const NpBatch& b, double thickness, int depth,
                                 NpVerdict* verdict) {
-  return isa >= 0 && run_on(isa, kDistance, kind, b, thickness, depth, verdict);
+  return isa >= 0 && simd::run_on(isa, kDistance, kind, b, thickness, depth, verdict);
 }
 
 int batch_isa() {
-  return widest_isa();
+  return simd::widest_isa();
 }
 
 bool np_filter_batch_with(int isa, Kind kind, const NpBatch& b, NpVerdict* verdict) {
-  return isa >= 0 && run_on(isa, kNp, kind, b, verdict);
+  return isa >= 0 && simd::run_on(isa, kNp, kind, b, verdict);
 }
 
 }  // namespace clothcd::ccd_detail

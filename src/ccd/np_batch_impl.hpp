@@ -16,18 +16,18 @@
 #include <vector>
 
 #include "ccd/fast_path.hpp"
-#include "ccd/lanes.hpp"
 #include "ccd/motion.hpp"
 #include "ccd/np_batch.hpp"
+#include "core/lanes.hpp"
 
 namespace clothcd::ccd_detail {
 namespace NP_BATCH_NAMESPACE {
 
 // The 3-vector of lanes and the vector operations both routines share (lanes.hpp).
-using lanes::cross;
-using lanes::dot;
-using lanes::sub;
-using lanes::Vec3;
+using simd::lanes::cross;
+using simd::lanes::dot;
+using simd::lanes::sub;
+using simd::lanes::Vec3;
 template <class B>
 B max_abs(const Vec3<B>& p) {
   return xsimd::max(xsimd::max(xsimd::abs(p.x), xsimd::abs(p.y)), xsimd::abs(p.z));

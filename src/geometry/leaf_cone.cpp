@@ -8,6 +8,7 @@
 
 #include "clothcd/geometry/angle.hpp"
 #include "clothcd/geometry/cone.hpp"
+#include "geometry/patch_block.hpp"
 #include "patch_cone.hpp"
 #include "sphere_caps.hpp"
 #include "validate.hpp"
@@ -161,46 +162,45 @@ NormalCone patch_ccd_cone(std::span<const std::array<int, 3>> faces, std::span<c
   thread_local std::vector<NormalCone> cones;
   controls.clear();
   cones.clear();
-  // Squared norms within these bounds, and their products by two, neither overflow nor lose
-  // precision to subnormals, so every bound below holds as computed.
-  constexpr double kLo = 1e-140, kHi = 1e140;
-  auto in_range = [](double x) { return x >= kLo && x <= kHi; };
-  constexpr double u2 = kUnitRoundoff * kUnitRoundoff;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double worst_ratio2 = 0;  // the largest (error / length)^2 of a control vector
-  for (const int id : ids) {
-    const std::array<int, 3>& t = faces[id];
-    const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
-    const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
-    const Eigen::Vector3d e1_t0 = b0 - a0, e2_t0 = c0 - a0;
-    const Eigen::Vector3d e1_t1 = b1 - a1, e2_t1 = c1 - a1;
-    const BernsteinNormal n = bernstein_normal(a0, b0, c0, a1, b1, c1);
-    const double s10 = e1_t0.squaredNorm(), s20 = e2_t0.squaredNorm(), s11 = e1_t1.squaredNorm(),
-                 s21 = e2_t1.squaredNorm();
-    const double q0 = n.n0.squaredNorm(), q1 = n.n1.squaredNorm(), qx = n.nx.squaredNorm();
-    // ccd_leaf_cone's error bounds, squared: (err0 / len0)^2 with err0 = 16 u l10 l20 (the
-    // subnormal term vanishes at these scales, far below the factor two of safety in it), and
-    // errx / lenx <= 8 u sqrt(2 (s10 s21 + s11 s20) / qx) + 2 u, whose square is at most twice
-    // the sum of the terms' squares.
-    if (in_range(s10) && in_range(s20) && in_range(s11) && in_range(s21) && in_range(q0) &&
-        in_range(q1) && in_range(qx)) {
-      const double r0 = 256 * u2 * (s10 * s20) / q0, r1 = 256 * u2 * (s11 * s21) / q1;
-      const double rx = 256 * u2 * (s10 * s21 + s11 * s20) / qx + 8 * u2;
-      if (!(r0 < 1) || !(r1 < 1)) return saturated_cone();  // an end normal may vanish
-      if (rx < 1) {
-        worst_ratio2 = std::max({worst_ratio2, r0, r1, rx});
-        // Unit directions for the axis: weight every control direction alike.
-        for (const auto& [v, q] : {std::pair{&n.n0, q0}, {&n.nx, qx}, {&n.n1, q1}}) {
-          controls.push_back({*v, q});
-          sum += *v / std::sqrt(q);
+  // The triangles' control vectors a block at a time in lanes (patch_block.hpp), then taken in
+  // the triangles' order, so the sum rounds as one loop over them would.
+  thread_local std::vector<std::array<int, 3>> tris;
+  tris.clear();
+  for (const int id : ids)
+    tris.push_back(faces[id]);
+  const int nt = static_cast<int>(tris.size());
+  PatchBlock blk;
+  for (int base = 0; base < nt; base += PatchBlock::kLanes) {
+    const int count = std::min(PatchBlock::kLanes, nt - base);
+    patch_block(tris.data() + base, count, v_t0.data(), v_t1.data(), blk);
+    for (int l = 0; l < count; ++l) {
+      // ccd_leaf_cone's error bounds, squared: (err0 / len0)^2 with err0 = 16 u l10 l20 (the
+      // subnormal term vanishes within in_range's scales, far below the factor two of safety in
+      // it), and errx / lenx <= 8 u sqrt(2 (s10 s21 + s11 s20) / qx) + 2 u, whose square is at
+      // most twice the sum of the terms' squares.
+      if (blk.in_range[l] != 0) {
+        const double r0 = blk.r0[l], r1 = blk.r1[l], rx = blk.rx[l];
+        if (!(r0 < 1) || !(r1 < 1)) return saturated_cone();  // an end normal may vanish
+        if (rx < 1) {
+          worst_ratio2 = std::max({worst_ratio2, r0, r1, rx});
+          for (int i = 0; i < 3; ++i) {
+            controls.push_back(
+                {Eigen::Vector3d(blk.n[i][0][l], blk.n[i][1][l], blk.n[i][2][l]), blk.q[i][l]});
+            sum += Eigen::Vector3d(blk.unit[i][0][l], blk.unit[i][1][l], blk.unit[i][2][l]);
+          }
+          continue;
         }
-        continue;
       }
+      const std::array<int, 3>& t = tris[base + l];
+      const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
+      const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
+      const NormalCone c = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, LeafConePolicy::Exact);
+      if (c.saturated()) return c;
+      cones.push_back(c);
+      sum += c.axis;
     }
-    const NormalCone c = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, LeafConePolicy::Exact);
-    if (c.saturated()) return c;
-    cones.push_back(c);
-    sum += c.axis;
   }
   const double norm = sum.norm();
   if (!(norm > 1e-3)) return saturated_cone();

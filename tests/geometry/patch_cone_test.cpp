@@ -5,12 +5,15 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <vector>
 
 #include "clothcd/geometry/cone.hpp"
 #include "cone_sampling.hpp"
+#include "geometry/patch_block.hpp"
 #include "geometry/patch_cone.hpp"
+#include "support/isa_paths.hpp"
 
 namespace clothcd::patch_cone_test {
 namespace {
@@ -104,6 +107,45 @@ TEST(PatchCone, HoldsEveryNormalOfSmoothPatches) {
     narrow += c.saturated() ? 0 : 1;
   }
   EXPECT_GT(narrow, cases / 2);  // most smooth patches must give a usable cone
+}
+
+// Every vector body of the per-triangle part computes the scalar body's bits, on smooth and
+// random patches of every block size, at scales from tiny to huge (in_range false) and with
+// degenerate triangles.
+TEST(PatchCone, EveryVectorBodyMatchesTheScalarOne) {
+  auto same = [](const detail::PatchBlock& a, const detail::PatchBlock& b, int count) {
+    auto lanes = [&](const double* x, const double* y) {
+      return std::memcmp(x, y, sizeof(double) * static_cast<std::size_t>(count)) == 0;
+    };
+    bool ok = lanes(a.r0, b.r0) && lanes(a.r1, b.r1) && lanes(a.rx, b.rx) &&
+              lanes(a.in_range, b.in_range);
+    for (int i = 0; i < 3; ++i) {
+      ok = ok && lanes(a.q[i], b.q[i]);
+      for (int d = 0; d < 3; ++d)
+        ok = ok && lanes(a.n[i][d], b.n[i][d]) && lanes(a.unit[i][d], b.unit[i][d]);
+    }
+    return ok;
+  };
+  for (int seed = 0; seed < kCases / 20; ++seed) {
+    Rng rng(seed);
+    const int n = rng.integer(1, detail::PatchBlock::kLanes);
+    const double size = rng.chance(0.1) ? rng.log_uniform(1e-90, 1e90) : rng.log_uniform(1e-4, 1e2);
+    Patch p = random_patch(rng, n, size, rng.log_uniform(1e-9, 1.0),
+                           rng.chance(0.5) ? 0.0 : rng.log_uniform(1e-12, 2.0));
+    if (rng.chance(0.1)) p.x1[p.faces[0][1]] = p.x1[p.faces[0][0]];  // a triangle collapses
+    detail::PatchBlock want, got;
+    ASSERT_TRUE(detail::patch_block_with(0, p.faces.data(), n, p.x0.data(), p.x1.data(), want));
+    for (int isa = 1; isa <= 3; ++isa) {
+      const bool ran =
+          detail::patch_block_with(isa, p.faces.data(), n, p.x0.data(), p.x1.data(), got);
+      test::note_isa("patch_block", isa, ran);
+      if (!ran) continue;
+      ASSERT_TRUE(same(want, got, n)) << "isa " << isa << " seed " << seed;
+    }
+    detail::patch_block(p.faces.data(), n, p.x0.data(), p.x1.data(), got);
+    test::note_isa("patch_block", 4, true);
+    ASSERT_TRUE(same(want, got, n)) << "dispatch, seed " << seed;
+  }
 }
 
 TEST(PatchCone, HoldsEveryNormalOfRandomPatches) {

@@ -9,7 +9,7 @@
 
 #include <type_traits>
 
-namespace clothcd::ccd_detail::lanes {
+namespace clothcd::simd::lanes {
 
 /// m ? a : b for a scalar; a batch finds its own (xsimd::select) by argument lookup.
 template <class T>
@@ -44,4 +44,4 @@ T dot(const Vec3<T>& p, const Vec3<T>& q) {
   return p.x * q.x + p.y * q.y + p.z * q.z;
 }
 
-}  // namespace clothcd::ccd_detail::lanes
+}  // namespace clothcd::simd::lanes
