@@ -57,7 +57,10 @@ const Garment* garment(int which) {
   return g.get();
 }
 
-void refit_bench(benchmark::State& state, bool optimal) {
+// Times `refit(bvh, garment)` on the tree of the benchmark's garment, build and thread count;
+// with `cone_stats`, reports the internal cones' mean half-angle and saturated count.
+template <class Refit>
+void refit_bench(benchmark::State& state, Refit&& refit, bool cone_stats) {
   const Garment* g = garment(static_cast<int>(state.range(0)));
   if (g == nullptr) {
     state.SkipWithError("garments not found (set CLOTHCD_DATA)");
@@ -66,13 +69,12 @@ void refit_bench(benchmark::State& state, bool optimal) {
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
                               static_cast<std::size_t>(state.range(2)));
   Bvh bvh(*g->topology, g->v0, state.range(1) == 0 ? BvhBuild::Spatial : BvhBuild::Patch);
-  RefitOptions o;
-  const research::ConeRule rule =
-      optimal ? research::ConeRule::Optimal : research::ConeRule::Proposed;
   for (auto _ : state) {
-    research::refit(bvh, g->v0, g->v1, o, rule);
-    benchmark::DoNotOptimize(bvh.cones().data());
+    refit(bvh, *g);
+    benchmark::DoNotOptimize(bvh.nodes().data());
   }
+  state.counters["triangles"] = g->topology->num_faces();
+  if (!cone_stats) return;
   double sum = 0;
   int internal = 0, saturated = 0;
   for (std::size_t i = 0; i < bvh.nodes().size(); ++i) {
@@ -81,37 +83,34 @@ void refit_bench(benchmark::State& state, bool optimal) {
     saturated += bvh.cones()[i].saturated() ? 1 : 0;
     sum += std::min(bvh.cones()[i].half_angle, kSaturatedHalfAngle);
   }
-  state.counters["triangles"] = g->topology->num_faces();
   state.counters["internal_mean_deg"] = sum / std::max(1, internal) * 180 / std::numbers::pi;
   state.counters["saturated"] = saturated;
 }
 
+// The research refit with every node's cone by `rule`.
+void research_refit_bench(benchmark::State& state, research::ConeRule rule) {
+  refit_bench(
+      state,
+      [rule](Bvh& bvh, const Garment& g) {
+        research::refit(bvh, g.v0, g.v1, RefitOptions{}, rule);
+      },
+      true);
+}
 void BM_OptimalRefit(benchmark::State& state) {
-  refit_bench(state, true);
+  research_refit_bench(state, research::ConeRule::Optimal);
 }
 void BM_ProposedRefit(benchmark::State& state) {
-  refit_bench(state, false);
+  research_refit_bench(state, research::ConeRule::Proposed);
 }
 
 // The product refit a CCD pass runs: boxes only (culling none), or boxes and PROPOSED cones
 // from `min_triangles` triangles up (16: the simulator's sound culling; 0: every node).
 void product_refit_bench(benchmark::State& state, bool cones, int min_triangles) {
-  const Garment* g = garment(static_cast<int>(state.range(0)));
-  if (g == nullptr) {
-    state.SkipWithError("garments not found (set CLOTHCD_DATA)");
-    return;
-  }
-  tbb::global_control threads(tbb::global_control::max_allowed_parallelism,
-                              static_cast<std::size_t>(state.range(2)));
-  Bvh bvh(*g->topology, g->v0, state.range(1) == 0 ? BvhBuild::Spatial : BvhBuild::Patch);
   RefitOptions o;
   o.cones = cones;
   o.cone_min_triangles = min_triangles;
-  for (auto _ : state) {
-    bvh.refit(g->v0, g->v1, o);
-    benchmark::DoNotOptimize(bvh.nodes().data());
-  }
-  state.counters["triangles"] = g->topology->num_faces();
+  refit_bench(
+      state, [o](Bvh& bvh, const Garment& g) { bvh.refit(g.v0, g.v1, o); }, false);
 }
 
 void BM_BoxRefit(benchmark::State& state) {

@@ -166,15 +166,11 @@ NormalCone patch_ccd_cone(std::span<const std::array<int, 3>> faces, std::span<c
   double worst_ratio2 = 0;  // the largest (error / length)^2 of a control vector
   // The triangles' control vectors a block at a time in lanes (patch_block.hpp), then taken in
   // the triangles' order, so the sum rounds as one loop over them would.
-  thread_local std::vector<std::array<int, 3>> tris;
-  tris.clear();
-  for (const int id : ids)
-    tris.push_back(faces[id]);
-  const int nt = static_cast<int>(tris.size());
+  const int nt = static_cast<int>(ids.size());
   PatchBlock blk;
   for (int base = 0; base < nt; base += PatchBlock::kLanes) {
     const int count = std::min(PatchBlock::kLanes, nt - base);
-    patch_block(tris.data() + base, count, v_t0.data(), v_t1.data(), blk);
+    patch_block(faces.data(), ids.data() + base, count, v_t0.data(), v_t1.data(), blk);
     for (int l = 0; l < count; ++l) {
       // ccd_leaf_cone's error bounds, squared: (err0 / len0)^2 with err0 = 16 u l10 l20 (the
       // subnormal term vanishes within in_range's scales, far below the factor two of safety in
@@ -193,7 +189,7 @@ NormalCone patch_ccd_cone(std::span<const std::array<int, 3>> faces, std::span<c
           continue;
         }
       }
-      const std::array<int, 3>& t = tris[base + l];
+      const std::array<int, 3>& t = faces[ids[base + l]];
       const Eigen::Vector3d &a0 = v_t0[t[0]], &b0 = v_t0[t[1]], &c0 = v_t0[t[2]];
       const Eigen::Vector3d &a1 = v_t1[t[0]], &b1 = v_t1[t[1]], &c1 = v_t1[t[2]];
       const NormalCone c = ccd_leaf_cone(a0, b0, c0, a1, b1, c1, LeafConePolicy::Exact);

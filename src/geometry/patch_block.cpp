@@ -8,15 +8,15 @@
 
 namespace clothcd::detail {
 
-using PatchBody = void (*)(const std::array<int, 3>*, int, const Eigen::Vector3d*,
+using PatchBody = void (*)(const std::array<int, 3>*, const int*, int, const Eigen::Vector3d*,
                            const Eigen::Vector3d*, PatchBlock&);
 
 #if CLOTHCD_SIMD_X86
-void patch_block_sse2(const std::array<int, 3>*, int, const Eigen::Vector3d*,
+void patch_block_sse2(const std::array<int, 3>*, const int*, int, const Eigen::Vector3d*,
                       const Eigen::Vector3d*, PatchBlock&);
-void patch_block_avx2(const std::array<int, 3>*, int, const Eigen::Vector3d*,
+void patch_block_avx2(const std::array<int, 3>*, const int*, int, const Eigen::Vector3d*,
                       const Eigen::Vector3d*, PatchBlock&);
-void patch_block_avx512(const std::array<int, 3>*, int, const Eigen::Vector3d*,
+void patch_block_avx512(const std::array<int, 3>*, const int*, int, const Eigen::Vector3d*,
                         const Eigen::Vector3d*, PatchBlock&);
 #endif
 
@@ -29,15 +29,15 @@ constexpr PatchBody kBodies[4] = {scalar_impl::patch_block<double>, nullptr, nul
 #endif
 }  // namespace
 
-void patch_block(const std::array<int, 3>* triangles, int count, const Eigen::Vector3d* v0,
-                 const Eigen::Vector3d* v1, PatchBlock& out) {
+void patch_block(const std::array<int, 3>* faces, const int* ids, int count,
+                 const Eigen::Vector3d* v0, const Eigen::Vector3d* v1, PatchBlock& out) {
   static const PatchBody body = kBodies[simd::widest_isa()];
-  body(triangles, count, v0, v1, out);
+  body(faces, ids, count, v0, v1, out);
 }
 
-bool patch_block_with(int isa, const std::array<int, 3>* triangles, int count,
+bool patch_block_with(int isa, const std::array<int, 3>* faces, const int* ids, int count,
                       const Eigen::Vector3d* v0, const Eigen::Vector3d* v1, PatchBlock& out) {
-  return isa >= 0 && simd::run_on(isa, kBodies, triangles, count, v0, v1, out);
+  return isa >= 0 && simd::run_on(isa, kBodies, faces, ids, count, v0, v1, out);
 }
 
 }  // namespace clothcd::detail

@@ -18,13 +18,13 @@ struct alignas(64) PatchBlock {
   double r0[kLanes], r1[kLanes], rx[kLanes], in_range[kLanes];
 };
 
-/// Fills lanes [0, count) of `out` for triangles[0, count), count in [1, kLanes], moving from
-/// positions v0 to v1; every body gives the same bits.
-void patch_block(const std::array<int, 3>* triangles, int count, const Eigen::Vector3d* v0,
-                 const Eigen::Vector3d* v1, PatchBlock& out);
+/// Fills lanes [0, count) of `out` for triangles faces[ids[0, count)], count in [1, kLanes],
+/// moving from positions v0 to v1; every body gives the same bits.
+void patch_block(const std::array<int, 3>* faces, const int* ids, int count,
+                 const Eigen::Vector3d* v0, const Eigen::Vector3d* v1, PatchBlock& out);
 /// The same on body `isa` (0 scalar, 1 SSE2, 2 AVX2, 3 AVX-512F); false, running nothing, where
 /// the processor or the build lacks it. For tests.
-bool patch_block_with(int isa, const std::array<int, 3>* triangles, int count,
+bool patch_block_with(int isa, const std::array<int, 3>* faces, const int* ids, int count,
                       const Eigen::Vector3d* v0, const Eigen::Vector3d* v1, PatchBlock& out);
 
 }  // namespace clothcd::detail

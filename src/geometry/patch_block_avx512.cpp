@@ -6,9 +6,9 @@
 
 namespace clothcd::detail {
 
-void patch_block_avx512(const std::array<int, 3>* triangles, int count, const Eigen::Vector3d* v0,
-                        const Eigen::Vector3d* v1, PatchBlock& out) {
-  avx512_impl::patch_block<xsimd::batch<double, xsimd::avx512f>>(triangles, count, v0, v1, out);
+void patch_block_avx512(const std::array<int, 3>* faces, const int* ids, int count,
+                        const Eigen::Vector3d* v0, const Eigen::Vector3d* v1, PatchBlock& out) {
+  avx512_impl::patch_block<xsimd::batch<double, xsimd::avx512f>>(faces, ids, count, v0, v1, out);
 }
 
 }  // namespace clothcd::detail

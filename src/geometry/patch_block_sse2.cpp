@@ -5,9 +5,9 @@
 
 namespace clothcd::detail {
 
-void patch_block_sse2(const std::array<int, 3>* triangles, int count, const Eigen::Vector3d* v0,
-                      const Eigen::Vector3d* v1, PatchBlock& out) {
-  sse2_impl::patch_block<xsimd::batch<double, xsimd::sse2>>(triangles, count, v0, v1, out);
+void patch_block_sse2(const std::array<int, 3>* faces, const int* ids, int count,
+                      const Eigen::Vector3d* v0, const Eigen::Vector3d* v1, PatchBlock& out) {
+  sse2_impl::patch_block<xsimd::batch<double, xsimd::sse2>>(faces, ids, count, v0, v1, out);
 }
 
 }  // namespace clothcd::detail

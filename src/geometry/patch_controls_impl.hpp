@@ -54,7 +54,9 @@ template <class T>
     c.q[i] = dot(c.n[i], c.n[i]);
   const T lo(1e-140), hi(1e140);
   auto in = [&](const T& x) { return (x >= lo) & (x <= hi); };
-  const auto ok = in(s10)&in(s20)&in(s11)&in(s21)&in(c.q[0]) & in(c.q[1]) & in(c.q[2]);
+  auto ok = in(s10);
+  for (const T& x : {s20, s11, s21, c.q[0], c.q[1], c.q[2]})
+    ok = ok & in(x);
   c.in_range = select(ok, T(1.0), T(0.0));
   const T k256(256 * u2);
   c.r0 = k256 * (s10 * s20) / c.q[0];
@@ -67,21 +69,15 @@ template <class T>
   return c;
 }
 
-}  // namespace PATCH_CONTROLS_NAMESPACE
-}  // namespace clothcd::detail
-
-namespace clothcd::detail {
-namespace PATCH_CONTROLS_NAMESPACE {
-
-// Gathers triangles[0, count) (count in [1, 8]; the last repeats into the unused lanes) and
+// Gathers faces[ids[0, count)] (count in [1, 8]; the last repeats into the unused lanes) and
 // computes their controls with batches of B::size lanes (B double: one at a time).
 template <class B>
-void patch_block(const std::array<int, 3>* triangles, int count, const Eigen::Vector3d* v0,
-                 const Eigen::Vector3d* v1, PatchBlock& out) {
+void patch_block(const std::array<int, 3>* faces, const int* ids, int count,
+                 const Eigen::Vector3d* v0, const Eigen::Vector3d* v1, PatchBlock& out) {
   constexpr int L = PatchBlock::kLanes;
   alignas(64) double x[18][L];
   for (int l = 0; l < L; ++l) {
-    const std::array<int, 3>& t = triangles[l < count ? l : count - 1];
+    const std::array<int, 3>& t = faces[ids[l < count ? l : count - 1]];
     for (int j = 0; j < 3; ++j) {
       for (int d = 0; d < 3; ++d) {
         x[3 * j + d][l] = v0[t[j]][d];

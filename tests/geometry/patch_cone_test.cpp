@@ -134,15 +134,16 @@ TEST(PatchCone, EveryVectorBodyMatchesTheScalarOne) {
                            rng.chance(0.5) ? 0.0 : rng.log_uniform(1e-12, 2.0));
     if (rng.chance(0.1)) p.x1[p.faces[0][1]] = p.x1[p.faces[0][0]];  // a triangle collapses
     detail::PatchBlock want, got;
-    ASSERT_TRUE(detail::patch_block_with(0, p.faces.data(), n, p.x0.data(), p.x1.data(), want));
+    ASSERT_TRUE(detail::patch_block_with(0, p.faces.data(), p.ids.data(), n, p.x0.data(),
+                                         p.x1.data(), want));
     for (int isa = 1; isa <= 3; ++isa) {
-      const bool ran =
-          detail::patch_block_with(isa, p.faces.data(), n, p.x0.data(), p.x1.data(), got);
+      const bool ran = detail::patch_block_with(isa, p.faces.data(), p.ids.data(), n, p.x0.data(),
+                                                p.x1.data(), got);
       test::note_isa("patch_block", isa, ran);
       if (!ran) continue;
       ASSERT_TRUE(same(want, got, n)) << "isa " << isa << " seed " << seed;
     }
-    detail::patch_block(p.faces.data(), n, p.x0.data(), p.x1.data(), got);
+    detail::patch_block(p.faces.data(), p.ids.data(), n, p.x0.data(), p.x1.data(), got);
     test::note_isa("patch_block", 4, true);
     ASSERT_TRUE(same(want, got, n)) << "dispatch, seed " << seed;
   }
