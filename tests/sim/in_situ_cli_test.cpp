@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -41,6 +42,21 @@ TEST(InSitu, ReportsEverySettingOnIdenticalFrames) {
         "- commit: ", "- machine: ", "load average", "## swing", "| PROVOT |", "| PROPOSED |",
         "| EXACT |", "| none |", "0.75", "0.82", "| cone PROVOT |", "| cone PROPOSED |"}) {
     EXPECT_NE(md.find(want), std::string::npos) << want << "\n" << md;
+  }
+  // The comparison with none: none against itself is 1, with no cost and no saving; a row of
+  // figures for every other setting.
+  const std::size_t against = md.find("Against `none`, per substep");
+  ASSERT_NE(against, std::string::npos) << md;
+  const std::string section = md.substr(against);
+  EXPECT_TRUE(std::regex_search(
+      section, std::regex(R"(\| none \| [0-9.]+ \| 1\.000 \| 0\.000 \| 0\.000 \| 1\.000 \|)")))
+      << section;
+  for (const char* s : {"PROVOT", "PROPOSED", "EXACT"}) {
+    EXPECT_TRUE(std::regex_search(
+        section, std::regex(std::string(R"(\| )") + s +
+                            R"( \| [0-9.]+ \| [0-9.]+ \| -?[0-9.]+ \| -?[0-9.]+ \| [0-9.]+ \|)")))
+        << s << "\n"
+        << section;
   }
   std::stringstream csv(CliScratch::slurp(dir / "res/in_situ.csv"));
   std::string line;
