@@ -92,8 +92,10 @@ TEST(InSitu, ReportsEverySettingOnIdenticalFrames) {
   };
   std::map<std::string, Sums> sum;
   for (const auto& [frame, by] : rows) {
-    for (const auto& [setting, row] : by) {
+    for (const auto& [setting, cells] : by) {
       Sums& t = sum[setting];
+      // A named reference: clang before 16 cannot capture a structured binding.
+      const auto& row = cells;
       const auto at = [&](const char* c) { return std::stod(row[col[c]]); };
       t.substeps += at("substeps");
       t.tests += 1e3 * (at("refit_s") + at("traversal_s"));
