@@ -229,9 +229,7 @@ std::string against_none(const SceneResult& r) {
       "over none's), ms | saved (narrow + proximity under none's), ms | vs none if cones were "
       "free |\n"
       "|---|---|---|---|---|---|\n";
-  const auto ms = [](double s, long long substeps) {
-    return substeps > 0 ? 1e3 * s / static_cast<double>(substeps) : 0.0;
-  };
+  const auto ms = [](double s, long long substeps) { return 1e3 * per_call(s, substeps); };
   const Totals& none = r.totals[0];
   const double n_tests = ms(none.ccd.refit_s + none.ccd.traversal_s, none.substeps);
   const double n_rest = ms(none.ccd.narrow_s + none.proximity.query_s, none.substeps);

@@ -105,7 +105,8 @@ TEST(InSitu, ReportsEverySettingOnIdenticalFrames) {
   const std::size_t against = md.find("Against `none`, per substep");
   ASSERT_NE(against, std::string::npos) << md;
   std::stringstream section(md.substr(against));
-  const Sums& n = sum["none"];
+  ASSERT_TRUE(sum.contains("none"));
+  const Sums& n = sum.at("none");
   const double n_tests = n.tests / n.substeps, n_rest = n.rest / n.substeps;
   int checked = 0;
   while (std::getline(section, line)) {
@@ -115,7 +116,7 @@ TEST(InSitu, ReportsEverySettingOnIdenticalFrames) {
     for (std::string c; std::getline(cells, c, '|');)
       cell.push_back(c.size() > 2 ? c.substr(1, c.size() - 2) : c);
     if (cell.size() != 7 || !sum.contains(cell[1])) continue;
-    const Sums& t = sum[cell[1]];
+    const Sums& t = sum.at(cell[1]);
     const double tests = t.tests / t.substeps, rest = t.rest / t.substeps;
     const double want[5] = {tests + rest, (tests + rest) / (n_tests + n_rest), tests - n_tests,
                             n_rest - rest, (n_tests + rest) / (n_tests + n_rest)};
