@@ -6,10 +6,11 @@ Usage: scripts/stitch_gaps.py [--first N] [--last N] DIR [DIR ...]
 A stitch ties vertex a to the point (1 - r) x_b + r x_c of another panel's edge (the pattern
 file's `stitch a b c r` lines, which the scene names with `"stitches": "pattern"`); its gap is
 the distance between the two in a frame. A closed seam has gaps of a fraction of a millimetre
-(the dress's drape: median 0.002 mm, p90 0.05 mm). Prints one markdown row per folder: the range over the
-frames first..last (all by default) of the per-frame median, p90 and largest gap in
+(the dress's drape: median 0.002 mm, p90 0.05 mm). Prints one markdown row per folder: the range
+over the frames first..last (all by default) of the per-frame median, p90 and largest gap in
 millimetres, and the last frame's figures. Quantiles are nearest rank.
 """
+import argparse
 import json
 import math
 import sys
@@ -68,26 +69,24 @@ def gaps(x, stitches):
 
 
 def main(argv):
-    first, last, folders = 1, 10**9, []
-    it = iter(argv)
-    for a in it:
-        if a == "--first":
-            first = int(next(it))
-        elif a == "--last":
-            last = int(next(it))
-        else:
-            folders.append(Path(a))
-    if not folders:
-        print(__doc__, file=sys.stderr)
-        return 2
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--first", type=int, default=1, help="first frame (default 1)")
+    ap.add_argument("--last", type=int, default=10**9, help="last frame (default: the run's last)")
+    ap.add_argument("folders", nargs="+", type=Path, metavar="DIR")
+    args = ap.parse_args(argv)
+    first, last, folders = args.first, args.last, args.folders
     out = []  # every folder measured before anything is printed: no partial table on an error
     for folder in folders:
         m, stitches = stitches_of(folder)
         rows = {}
         for k in range(first, min(last, m["complete_frames"]) + 1):
-            x, _, _, _ = read_obj(folder / f"frame_{k:04d}.obj")
+            frame = folder / f"frame_{k:04d}.obj"
+            if not frame.is_file():
+                raise SystemExit(f"{frame}: missing, though the manifest counts "
+                                 f"{m['complete_frames']} complete frames")
+            x, _, _, _ = read_obj(frame)
             if max(max(s[:3]) for s in stitches) >= len(x):
-                raise SystemExit(f"{folder}/frame_{k:04d}.obj: {len(x)} vertices, fewer than "
+                raise SystemExit(f"{frame}: {len(x)} vertices, fewer than "
                                  "the stitches refer to")
             g = gaps(x, stitches)
             rows[k] = [1e3 * quantile(g, 0.5), 1e3 * quantile(g, 0.9), 1e3 * g[-1]]

@@ -1,5 +1,6 @@
 // scripts/stitch_gaps.py on a hand-made run folder: three stitches whose gaps are 1, 2 and 3 mm
-// by construction, and the errors for a malformed stitch line and a folder without a manifest.
+// by construction, and the errors for a malformed stitch line, a missing frame file and a folder
+// without a manifest.
 // Needs /usr/bin/python3 (the script uses the standard library only) and skips without it.
 #include <gtest/gtest.h>
 
@@ -73,6 +74,13 @@ TEST(StitchGapsScript, GapsOfAHandMadeRun) {
   EXPECT_NE(b.output.find("pattern.obj:9: expected 'stitch a b c r'"), std::string::npos)
       << b.output;
   EXPECT_EQ(b.output.find("| tiny |"), std::string::npos) << "no partial output: " << b.output;
+
+  const fs::path gone =
+      make_run(base / "gone", "stitch 3 0 1 0.5\nstitch 4 0 1 0.25\nstitch 5 0 1 0.75\n");
+  fs::remove(gone / "frame_0001.obj");
+  const ScriptRun g = run_script(gone);
+  EXPECT_NE(g.status, 0) << g.output;
+  EXPECT_NE(g.output.find("frame_0001.obj: missing"), std::string::npos) << g.output;
 
   const ScriptRun none = run_script(base / "missing");
   EXPECT_NE(none.status, 0) << none.output;
