@@ -16,6 +16,7 @@ manifest's per-frame `strain` instead (the simulator's own, from the same formul
 --over adds a column with the number of frames whose p99, p99.9 and largest strain exceed the
 three given fractions, e.g. --over 0.05,0.1,0.2.
 """
+import argparse
 import json
 import math
 import os
@@ -29,37 +30,83 @@ def data_path(text: str, scene_file: Path) -> Path:
     return p if p.is_absolute() else scene_file.parent / p
 
 
+def data_file(scene_file: Path, cloth: dict, key: str) -> Path:
+    """The existing file that the scene's cloth.<key> names (as the simulator resolves it)."""
+    if key not in cloth:
+        raise SystemExit(f"{scene_file}: cloth.{key} is not set")
+    p = data_path(cloth[key], scene_file)
+    if not p.is_file():
+        hint = " (set CLOTHCD_DATA to the shared data folder)" if "${CLOTHCD_DATA}" in cloth[key] else ""
+        raise SystemExit(f"{scene_file}: cloth.{key} names {p}, which is missing{hint}")
+    return p
+
+
+def read_manifest(folder: Path):
+    manifest = folder / "manifest.json"
+    if not manifest.is_file():
+        raise SystemExit(f"{folder}: no manifest.json (not a clothcd simulate folder)")
+    try:
+        return json.loads(manifest.read_text())
+    except json.JSONDecodeError as e:
+        raise SystemExit(f"{manifest}: invalid JSON ({e})") from None
+
+
+def scene_cloth(m: dict, folder: Path):
+    """The scene file a manifest names and its cloth section."""
+    scene_file = Path(m.get("scene_file", ""))
+    if not scene_file.is_file():
+        raise SystemExit(f"{folder}: the scene file its manifest names, {scene_file}, is missing")
+    try:
+        return scene_file, json.loads(scene_file.read_text())["cloth"]
+    except (json.JSONDecodeError, KeyError, TypeError):
+        raise SystemExit(f"{scene_file}: not a scene (no cloth section)") from None
+
+
 def read_obj(path: Path, want_vt: bool = False):
     v, vt, faces, face_vt = [], [], [], []
+    if not path.is_file():
+        raise SystemExit(f"{path}: missing")
     with open(path) as f:
-        for line in f:
-            if line.startswith("v "):
-                _, x, y, z = line.split()[:4]
-                v.append((float(x), float(y), float(z)))
-            elif want_vt and line.startswith("vt "):
-                p = line.split()
-                vt.append((float(p[1]), float(p[2])))
-            elif line.startswith("f "):
-                idx = [t.split("/") for t in line.split()[1:4]]
-                faces.append(tuple(int(t[0]) - 1 for t in idx))
-                if want_vt:
-                    face_vt.append(tuple(int(t[1]) - 1 if len(t) > 1 and t[1] else -1 for t in idx))
+        for number, line in enumerate(f, 1):
+            try:
+                if line.startswith("v "):
+                    _, x, y, z = line.split()[:4]
+                    v.append((float(x), float(y), float(z)))
+                elif want_vt and line.startswith("vt "):
+                    p = line.split()
+                    vt.append((float(p[1]), float(p[2])))
+                elif line.startswith("f "):
+                    idx = [t.split("/") for t in line.split()[1:4]]
+                    if len(idx) != 3:
+                        raise ValueError
+                    faces.append(tuple(int(t[0]) - 1 for t in idx))
+                    if want_vt:
+                        face_vt.append(tuple(int(t[1]) - 1 if len(t) > 1 and t[1] else -1
+                                             for t in idx))
+            except (ValueError, IndexError):
+                raise SystemExit(f"{path}:{number}: expected 'v x y z', 'vt u v' or a triangle "
+                                 f"'f a b c', got {line.strip()!r}") from None
     return v, vt, faces, face_vt
 
 
-def rest_grams(scene_file: Path):
-    """Faces of the cloth and each face's rest Gram matrix (r11, r12, r22), or None if degenerate."""
-    scene = json.loads(scene_file.read_text())
-    cloth = scene["cloth"]
-    v, _, faces, _ = read_obj(data_path(cloth["obj"], scene_file))
+def rest_grams(scene_file: Path, cloth: dict):
+    """Faces of the scene's cloth and each face's rest Gram matrix (r11, r12, r22, det), or None
+    if degenerate."""
+    obj = data_file(scene_file, cloth, "obj")
+    v, _, faces, _ = read_obj(obj)
     nv = cloth.get("vertices", len(v))
     faces = [f for f in faces if max(f) < nv][: cloth.get("faces", len(faces))]
     if cloth.get("rest", "initial") == "pattern":
-        _, vt, pfaces, pvt = read_obj(data_path(cloth["pattern"], scene_file), want_vt=True)
+        pattern = data_file(scene_file, cloth, "pattern")
+        _, vt, pfaces, pvt = read_obj(pattern, want_vt=True)
         rest = [None] * nv
         for f, t in zip(pfaces, pvt):
             for a, b in zip(f, t):
+                if not 0 <= b < len(vt):
+                    raise SystemExit(f"{pattern}: a face corner without a 'vt' pattern point")
                 rest[a] = (vt[b][0], vt[b][1], 0.0)
+        if any(r is None for r in rest):
+            raise SystemExit(f"{pattern}: some of the cloth's {nv} vertices have no pattern point")
     else:
         rest = v[:nv]
     grams = []
@@ -107,20 +154,30 @@ def figures(s):
 
 
 def measure(folder: Path, first: int, last: int):
-    m = json.loads((folder / "manifest.json").read_text())
-    faces, grams = rest_grams(Path(m["scene_file"]))
+    m = read_manifest(folder)
+    scene_file, cloth = scene_cloth(m, folder)
     ext = m.get("mesh_format", "obj")
     if ext != "obj":
         raise SystemExit(f"{folder}: only OBJ frames are read, this run wrote {ext}")
+    faces, grams = rest_grams(scene_file, cloth)
     frames = {}
-    for k in range(first, min(last, m["complete_frames"]) + 1):
-        x, _, _, _ = read_obj(folder / f"frame_{k:04d}.obj")
-        frames[k] = figures(strains(x, faces, grams))
+    for k in range(first, min(last, m.get("complete_frames", 0)) + 1):
+        frame = folder / f"frame_{k:04d}.obj"
+        if not frame.is_file():
+            raise SystemExit(f"{frame}: missing, though the manifest counts "
+                             f"{m['complete_frames']} complete frames")
+        x, _, _, _ = read_obj(frame)
+        if faces and max(max(f) for f in faces) >= len(x):
+            raise SystemExit(f"{frame}: {len(x)} vertices, fewer than the cloth's faces use")
+        s = strains(x, faces, grams)
+        if not s:
+            raise SystemExit(f"{scene_file}: no triangle with a non-degenerate rest shape")
+        frames[k] = figures(s)
     return m["scene"], frames
 
 
 def from_manifest(folder: Path, first: int, last: int):
-    m = json.loads((folder / "manifest.json").read_text())
+    m = read_manifest(folder)
     keys = ("median", "p90", "p99", "p999", "max", "over_10")
     frames = {f["frame"]: {k: f["strain"][k] for k in keys} for f in m["frames"]
               if "strain" in f and first <= f["frame"] <= last}
@@ -131,38 +188,37 @@ def span(values, scale=100.0):
     return f"{scale * min(values):.1f}-{scale * max(values):.1f}%"
 
 
+def fractions(text: str):
+    try:
+        over = [float(t) for t in text.split(",")]
+    except ValueError:
+        over = []
+    if len(over) != 3:
+        raise argparse.ArgumentTypeError(f"expected three fractions P99,P999,MAX, got {text!r}")
+    return over
+
+
 def main(argv):
-    first, last, out, folders, use_manifest, over = 1, 10**9, None, [], False, None
-    it = iter(argv)
-    for a in it:
-        if a == "--manifest":
-            use_manifest = True
-        elif a == "--over":
-            over = [float(t) for t in next(it).split(",")]
-            if len(over) != 3:
-                raise SystemExit("--over takes three fractions: P99,P999,MAX")
-        elif a == "--first":
-            first = int(next(it))
-        elif a == "--last":
-            last = int(next(it))
-        elif a == "--json":
-            out = Path(next(it))
-        else:
-            folders.append(Path(a))
-    if not folders:
-        print(__doc__, file=sys.stderr)
-        return 2
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--first", type=int, default=1, help="first frame (default 1)")
+    ap.add_argument("--last", type=int, default=10**9, help="last frame (default: the run's last)")
+    ap.add_argument("--json", type=Path, help="also write the per-frame figures to this file")
+    ap.add_argument("--manifest", action="store_true",
+                    help="the simulator's own per-frame figures from the manifest (fast)")
+    ap.add_argument("--over", type=fractions, metavar="P99,P999,MAX",
+                    help="count the frames above these p99, p99.9 and largest strains")
+    ap.add_argument("folders", nargs="+", type=Path, metavar="DIR")
+    args = ap.parse_args(argv)
+    over = args.over
     head = "| run | frames | median | p90 | p99 | p99.9 | max per frame | over 10% |"
     rule = "|---|---|---|---|---|---|---|---|"
     if over:
         head += (f" frames over p99 {100 * over[0]:g}% / p99.9 {100 * over[1]:g}% / "
                  f"max {100 * over[2]:g}% |")
         rule += "---|"
-    print(head)
-    print(rule)
-    dump = {}
-    for folder in folders:
-        scene, frames = (from_manifest if use_manifest else measure)(folder, first, last)
+    rows, dump = [], {}  # every folder measured before anything is printed: no partial table
+    for folder in args.folders:
+        scene, frames = (from_manifest if args.manifest else measure)(folder, args.first, args.last)
         dump[str(folder)] = frames
         if not frames:
             continue
@@ -171,9 +227,13 @@ def main(argv):
         if over:
             cells.append(" / ".join(str(sum(1 for x in f if x[k] > t))
                                     for k, t in zip(("p99", "p999", "max"), over)))
-        print(f"| {scene} | {min(frames)}-{max(frames)} | " + " | ".join(cells) + " |")
-    if out:
-        out.write_text(json.dumps(dump, indent=1) + "\n")
+        rows.append(f"| {scene} | {min(frames)}-{max(frames)} | " + " | ".join(cells) + " |")
+    if args.json:
+        args.json.write_text(json.dumps(dump, indent=1) + "\n")
+    print(head)
+    print(rule)
+    for row in rows:
+        print(row)
     return 0
 
 

@@ -11,13 +11,12 @@ over the frames first..last (all by default) of the per-frame median, p90 and la
 millimetres, and the last frame's figures. Quantiles are nearest rank.
 """
 import argparse
-import json
 import math
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from frame_strain import data_path, quantile, read_obj  # noqa: E402
+from frame_strain import data_file, quantile, read_manifest, read_obj, scene_cloth  # noqa: E402
 
 
 def read_stitches(path: Path):
@@ -41,20 +40,14 @@ def read_stitches(path: Path):
 
 
 def stitches_of(folder: Path):
-    manifest = folder / "manifest.json"
-    if not manifest.is_file():
-        raise SystemExit(f"{folder}: no manifest.json (not a clothcd simulate folder)")
-    m = json.loads(manifest.read_text())
-    scene_file = Path(m["scene_file"])
-    if not scene_file.is_file():
-        raise SystemExit(f"{folder}: the scene file its manifest names, {scene_file}, is missing")
-    cloth = json.loads(scene_file.read_text())["cloth"]
+    m = read_manifest(folder)
+    scene_file, cloth = scene_cloth(m, folder)
     if cloth.get("stitches", "none") != "pattern":
         raise SystemExit(f"{scene_file}: only stitches read from the pattern file are measured "
                          f"(cloth.stitches is {cloth.get('stitches', 'none')!r})")
     if m.get("mesh_format", "obj") != "obj":
         raise SystemExit(f"{folder}: only OBJ frames are read, this run wrote {m['mesh_format']}")
-    stitches = read_stitches(data_path(cloth["pattern"], scene_file))
+    stitches = read_stitches(data_file(scene_file, cloth, "pattern"))
     if not stitches:
         raise SystemExit(f"{scene_file}: its pattern file has no stitch lines")
     return m, stitches
@@ -79,7 +72,7 @@ def main(argv):
     for folder in folders:
         m, stitches = stitches_of(folder)
         rows = {}
-        for k in range(first, min(last, m["complete_frames"]) + 1):
+        for k in range(first, min(last, m.get("complete_frames", 0)) + 1):
             frame = folder / f"frame_{k:04d}.obj"
             if not frame.is_file():
                 raise SystemExit(f"{frame}: missing, though the manifest counts "
