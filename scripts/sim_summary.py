@@ -121,6 +121,38 @@ def strain_row(folder: Path) -> str | None:
     )
 
 
+def tables(folders: list[Path], parts: bool) -> list[str]:
+    """Every line of the output; raises on the first folder that cannot be read."""
+    out = ["| scene | frames | s/frame median / mean | collision share | substeps/frame | "
+           "intersecting pairs self / body at frame 0 | worst frame | last frame | "
+           "frames with 0 / 0 | unresolved CCD hits |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    out += [row(d) for d in folders]
+    strain = [r for r in (strain_row(d) for d in folders) if r is not None]
+    if strain:
+        out += ["",
+                "| scene | strain limit | frames | largest median | worst p99 (frame) | "
+                "worst p99.9 (frame) | largest (frame) | frames whose largest sits at seam / "
+                "sliver / body contact / elsewhere | limiter time share |",
+                "|---|---|---:|---:|---:|---:|---:|---|---:|"] + strain
+    if parts:
+        out += ["",
+                "| scene | frames | collision ms / substep | "
+                + " | ".join(name for _, name in PARTS) + " | between parts |",
+                "|---|---:|---:|" + "---:|" * (len(PARTS) + 1)]
+        out += [r for r in (parts_row(d) for d in folders) if r is not None]
+        out += ["",
+                "Self detector: its full CCD passes (the first of each substep) per call, their "
+                "share of all its CCD calls' time, and its proximity query per call and share of "
+                "the proximity part (the rest: the cloth-body query and the contacts built).",
+                "",
+                "| scene | full passes | triangle pairs / pass | refit ms | traversal ms | "
+                "narrow ms | share of CCD self | proximity query ms | share of proximity |",
+                "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        out += [r for r in (self_row(d) for d in folders) if r is not None]
+    return out
+
+
 def main() -> int:
     args = sys.argv[1:]
     parts = "--parts" in args
@@ -128,46 +160,15 @@ def main() -> int:
     if not args:
         print(__doc__, file=sys.stderr)
         return 2
-    print("| scene | frames | s/frame median / mean | collision share | substeps/frame | "
-          "intersecting pairs self / body at frame 0 | worst frame | last frame | "
-          "frames with 0 / 0 | unresolved CCD hits |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    # Every folder is read before anything is printed: no partial table on an error.
     for d in args:
         try:
-            print(row(Path(d)))
-        except (OSError, KeyError, ValueError) as e:
-            print(f"{d}: cannot read manifest.json: {e}", file=sys.stderr)
+            tables([Path(d)], parts)
+        except (OSError, KeyError, ValueError, TypeError, ZeroDivisionError) as e:
+            what = f"no {e.args[0]!r} in it" if isinstance(e, KeyError) else str(e)
+            print(f"{d}: cannot read manifest.json: {what}", file=sys.stderr)
             return 1
-    strain = [r for r in (strain_row(Path(d)) for d in args) if r is not None]
-    if strain:
-        print()
-        print("| scene | strain limit | frames | largest median | worst p99 (frame) | "
-              "worst p99.9 (frame) | largest (frame) | frames whose largest sits at seam / "
-              "sliver / body contact / elsewhere | limiter time share |")
-        print("|---|---|---:|---:|---:|---:|---:|---|---:|")
-        for r in strain:
-            print(r)
-    if parts:
-        print()
-        print("| scene | frames | collision ms / substep | "
-              + " | ".join(name for _, name in PARTS) + " | between parts |")
-        print("|---|---:|---:|" + "---:|" * (len(PARTS) + 1))
-        for d in args:
-            r = parts_row(Path(d))
-            if r is not None:
-                print(r)
-        print()
-        print("Self detector: its full CCD passes (the first of each substep) per call, their "
-              "share of all its CCD calls' time, and its proximity query per call and share of "
-              "the proximity part (the rest: the cloth-body query and the contacts built).")
-        print()
-        print("| scene | full passes | triangle pairs / pass | refit ms | traversal ms | "
-              "narrow ms | share of CCD self | proximity query ms | share of proximity |")
-        print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
-        for d in args:
-            r = self_row(Path(d))
-            if r is not None:
-                print(r)
+    print("\n".join(tables([Path(d) for d in args], parts)))
     return 0
 
 

@@ -1,6 +1,7 @@
-// scripts/stitch_gaps.py and scripts/frame_strain.py on hand-made run folders whose figures are
-// known by construction (stitch gaps of 1, 2 and 3 mm; a triangle stretched 20%), and their
-// errors for bad input: each names the file and what was expected, exits non-zero and prints no
+// The scripts that read `clothcd simulate` folders (stitch_gaps.py, frame_strain.py,
+// sim_summary.py) on hand-made folders whose figures are known by construction (stitch gaps of
+// 1, 2 and 3 mm; a triangle stretched 20%; two frames' times and counts), and their errors for
+// bad input: each names the file and what was expected, exits non-zero and prints no
 // table.
 // Needs /usr/bin/python3 (the scripts use the standard library only) and skips without it.
 #include <gtest/gtest.h>
@@ -10,7 +11,7 @@
 #include <fstream>
 #include <string>
 
-namespace strain_scripts_test {
+namespace run_scripts_test {
 
 namespace fs = std::filesystem;
 
@@ -176,4 +177,36 @@ TEST(FrameStrainScript, StrainOfAHandMadeRun) {
   fs::remove_all(base);
 }
 
-}  // namespace strain_scripts_test
+TEST(SimSummaryScript, RowOfAHandMadeRun) {
+  if (!fs::exists("/usr/bin/python3")) GTEST_SKIP() << "/usr/bin/python3 not found";
+  const fs::path base = scratch("clothcd_sim_summary_");
+  fs::create_directories(base / "good");
+  fs::create_directories(base / "bad");
+  write(base / "good" / "manifest.json",
+        "{\"scene\": \"tiny\", \"complete_frames\": 2, \"initial_self_intersections\": 0, "
+        "\"initial_body_intersections\": 0, \"frames\": ["
+        "{\"frame\": 1, \"seconds\": 2, \"collision_seconds\": 1, \"substeps\": 4, "
+        "\"self_intersections\": 0, \"body_intersections\": 0, \"unresolved_ccd_hits\": 0}, "
+        "{\"frame\": 2, \"seconds\": 4, \"collision_seconds\": 1, \"substeps\": 6, "
+        "\"self_intersections\": 2, \"body_intersections\": 1, \"unresolved_ccd_hits\": 3}]}");
+  write(base / "bad" / "manifest.json", "{\"scene\": \"tiny\", \"complete_frames\": 2}");
+  const auto summary = [&](const std::string& folders) {
+    return run_script("sim_summary.py", folders);
+  };
+  // Seconds 2 and 4 (median and mean 3), collisions 2 of 6 s, the worst and last frame 2.
+  const ScriptRun r = summary("'" + (base / "good").string() + "'");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("| tiny | 2 | 3.0 / 3.0 | 33% | 4-6 | 0 / 0 | 2 / 1 (frame 2) | 2 / 1 | "
+                          "1 | 3 in 1 frames |"),
+            std::string::npos)
+      << r.output;
+  const ScriptRun b =
+      summary("'" + (base / "good").string() + "' '" + (base / "bad").string() + "'");
+  EXPECT_NE(b.status, 0) << b.output;
+  EXPECT_NE(b.output.find("bad: cannot read manifest.json: no 'frames' in it"), std::string::npos)
+      << b.output;
+  EXPECT_EQ(b.output.find("| scene |"), std::string::npos) << "no partial output: " << b.output;
+  fs::remove_all(base);
+}
+
+}  // namespace run_scripts_test
