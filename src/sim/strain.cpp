@@ -14,9 +14,13 @@
 #include <cstdint>
 
 #include "clothcd/core/error.hpp"
+#include "sim/eig2.hpp"
 
 namespace clothcd::sim {
 namespace {
+using detail::certainly_within;
+using detail::eig2;
+using detail::Eig2;
 constexpr int kGrain = 256;
 // A stretch above the limit is set this share of its excess below it (docs/simulator.md 2.2). On
 // dress-rumba frames 1-3, 20 sweeps with 1 left p99 at 4.7-5.0% where 0 (clamping to the limit)
@@ -29,28 +33,6 @@ Eigen::Matrix<double, 3, 2> deformation(const Vec3& x0, const Vec3& x1, const Ve
   ds.col(0) = x1 - x0;
   ds.col(1) = x2 - x0;
   return ds * inv_rest;
-}
-
-// Eigenvalues (descending) of a symmetric 2x2 matrix and the unit eigenvector of the larger.
-struct Eig2 {
-  double l1, l2;
-  Vec2 v1;
-};
-Eig2 eig2(const Mat2& c) {
-  const double a = c(0, 0), b = c(0, 1), d = c(1, 1);
-  const double half = 0.5 * (a + d);
-  const double disc = std::sqrt(0.25 * (a - d) * (a - d) + b * b);
-  Eig2 e{half + disc, std::max(0.0, half - disc), Vec2::UnitX()};
-  // Of the two expressions of the eigenvector, the longer is the better conditioned.
-  const Vec2 p(e.l1 - d, b), q(b, e.l1 - a);
-  const Vec2 w = p.squaredNorm() >= q.squaredNorm() ? p : q;
-  const double n = w.norm();
-  if (n > 0.0) {
-    e.v1 = w / n;
-  } else if (d > a) {
-    e.v1 = Vec2::UnitY();
-  }
-  return e;
 }
 
 double strain_of(const Eigen::Matrix<double, 3, 2>& f) {
@@ -249,7 +231,10 @@ StrainLimitStats StrainLimiter::apply(std::span<const Vec3> x0, double h,
     if (!(moved_[a] | moved_[b] | moved_[c] | moved_next_[a] | moved_next_[b] | moved_next_[c]))
       return;
     const Eigen::Matrix<double, 3, 2> f = deformation(p_[a], p_[b], p_[c], tri.inv_rest);
-    const Eig2 e = eig2(f.transpose() * f);
+    const Mat2 gram = f.transpose() * f;
+    // Most checked triangles are within the limits: no eigen decomposition for them.
+    if (certainly_within(gram, lo2, hi2)) return;
+    const Eig2 e = eig2(gram);
     auto scale = [&](double l) {
       if (l > hi2) {
         // As far below the limit as it was above (never below rest length): Gauss-Seidel

@@ -1,5 +1,6 @@
 // Strain figures and the strain limiter: a stretched sheet comes back within the limit, limited
-// runs with collisions stay crossing-free, and the limiter is bitwise deterministic.
+// runs with collisions stay crossing-free, the limiter is bitwise deterministic, and its cheap
+// within-the-limits test never spares a triangle that eig2 puts over a limit.
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
@@ -14,9 +15,49 @@
 #include "clothcd/sim/strain.hpp"
 #include "grid.hpp"
 #include "hash.hpp"
+#include "sim/eig2.hpp"
 
 namespace clothcd::sim {
 namespace strain_test {
+
+// Gram matrices F^T F of triangles whose principal stretches lie a relative 1e-15 to 1e-2 on
+// either side of the limits, in every orientation: wherever certainly_within says yes, eig2's
+// eigenvalues (what the limiter decides from) are within the limits; it says yes for most
+// triangles clearly inside, and no for NaN.
+TEST(StrainLimiter, WithinTestNeverSparesATriangleOverALimit) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> angle(0.0, 6.283185307179586), sign(-1.0, 1.0);
+  std::uniform_int_distribution<int> digits(2, 15);
+  const double hi = 1.045, lo = 0.9;
+  int spared = 0, inside_cases = 0, inside_spared = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const double lo2 = (i % 2 == 0) ? 0.0 : lo * lo, hi2 = hi * hi;
+    // Stretches near a limit (or one well inside for every tenth), a random rotation of them.
+    const double near = std::pow(10.0, -digits(rng)) * sign(rng);
+    const bool inside = i % 10 == 0;
+    const double s1 = inside ? 1.02 : hi * (1.0 + near);
+    const double s2 = inside ? 0.97 : (i % 4 < 2 ? lo * (1.0 + near) : 1.0);
+    const double t = angle(rng);
+    Mat2 r;
+    r << std::cos(t), -std::sin(t), std::sin(t), std::cos(t);
+    const Mat2 c = r * Eigen::Vector2d(s1 * s1, s2 * s2).asDiagonal() * r.transpose();
+    inside_cases += inside ? 1 : 0;
+    if (!detail::certainly_within(c, lo2, hi2)) continue;
+    ++spared;
+    const detail::Eig2 e = detail::eig2(c);
+    ASSERT_LE(e.l1, hi2) << "stretches " << s1 << ", " << s2;
+    if (lo2 > 0.0) {
+      ASSERT_GE(e.l2, lo2) << "stretches " << s1 << ", " << s2;
+    }
+    inside_spared += inside ? 1 : 0;
+  }
+  EXPECT_GT(spared, inside_spared);        // some near the limits too
+  EXPECT_EQ(inside_spared, inside_cases);  // 2% and 3% from the limits: always spared
+  Mat2 nan = Mat2::Identity();
+  nan(0, 1) = nan(1, 0) = std::nan("");
+  EXPECT_FALSE(detail::certainly_within(nan, 0.0, hi * hi));
+  EXPECT_FALSE(detail::certainly_within(Mat2::Identity() * (hi * hi), 0.0, hi * hi));
+}
 
 using test::grid_cloth;
 
