@@ -80,6 +80,8 @@ def read_obj(path: Path, want_vt: bool = False):
                     if len(idx) != 3:
                         raise ValueError
                     faces.append(tuple(int(t[0]) - 1 for t in idx))
+                    if min(faces[-1]) < 0:
+                        raise ValueError
                     if want_vt:
                         face_vt.append(tuple(int(t[1]) - 1 if len(t) > 1 and t[1] else -1
                                              for t in idx))
@@ -105,8 +107,8 @@ def rest_grams(scene_file: Path, cloth: dict):
                 if not 0 <= b < len(vt):
                     raise SystemExit(f"{pattern}: a face corner without a 'vt' pattern point")
                 rest[a] = (vt[b][0], vt[b][1], 0.0)
-        if any(r is None for r in rest):
-            raise SystemExit(f"{pattern}: some of the cloth's {nv} vertices have no pattern point")
+        if any(rest[a] is None for f in faces for a in f):
+            raise SystemExit(f"{pattern}: a vertex of the cloth's faces has no pattern point")
     else:
         rest = v[:nv]
     grams = []
@@ -179,9 +181,13 @@ def measure(folder: Path, first: int, last: int):
 def from_manifest(folder: Path, first: int, last: int):
     m = read_manifest(folder)
     keys = ("median", "p90", "p99", "p999", "max", "over_10")
-    frames = {f["frame"]: {k: f["strain"][k] for k in keys} for f in m["frames"]
-              if "strain" in f and first <= f["frame"] <= last}
-    return m["scene"], frames
+    try:
+        frames = {f["frame"]: {k: f["strain"][k] for k in keys} for f in m["frames"]
+                  if "strain" in f and first <= f["frame"] <= last}
+        return m["scene"], frames
+    except (KeyError, TypeError) as e:
+        raise SystemExit(f"{folder / 'manifest.json'}: no per-frame strain figures "
+                         f"(missing {e})") from None
 
 
 def span(values, scale=100.0):
