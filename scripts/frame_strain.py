@@ -91,6 +91,16 @@ def read_obj(path: Path, want_vt: bool = False):
     return v, vt, faces, face_vt
 
 
+def frames_of(folder: Path, m: dict, first: int, last: int):
+    """(k, positions) of the folder's frames first..last that its manifest counts complete."""
+    for k in range(first, min(last, m.get("complete_frames", 0)) + 1):
+        frame = folder / f"frame_{k:04d}.obj"
+        if not frame.is_file():
+            raise SystemExit(f"{frame}: missing, though the manifest counts "
+                             f"{m['complete_frames']} complete frames")
+        yield k, frame, read_obj(frame)[0]
+
+
 def rest_grams(scene_file: Path, cloth: dict):
     """Faces of the scene's cloth and each face's rest Gram matrix (r11, r12, r22, det), or None
     if degenerate."""
@@ -163,12 +173,7 @@ def measure(folder: Path, first: int, last: int):
         raise SystemExit(f"{folder}: only OBJ frames are read, this run wrote {ext}")
     faces, grams = rest_grams(scene_file, cloth)
     frames = {}
-    for k in range(first, min(last, m.get("complete_frames", 0)) + 1):
-        frame = folder / f"frame_{k:04d}.obj"
-        if not frame.is_file():
-            raise SystemExit(f"{frame}: missing, though the manifest counts "
-                             f"{m['complete_frames']} complete frames")
-        x, _, _, _ = read_obj(frame)
+    for k, frame, x in frames_of(folder, m, first, last):
         if faces and max(max(f) for f in faces) >= len(x):
             raise SystemExit(f"{frame}: {len(x)} vertices, fewer than the cloth's faces use")
         s = strains(x, faces, grams)

@@ -153,6 +153,14 @@ def tables(folders: list[Path], parts: bool) -> list[str]:
     return out
 
 
+def readable(folder: Path, parts: bool) -> bool:
+    try:
+        tables([folder], parts)
+        return True
+    except (OSError, KeyError, ValueError, TypeError, ZeroDivisionError):
+        return False
+
+
 def main() -> int:
     args = sys.argv[1:]
     parts = "--parts" in args
@@ -160,15 +168,16 @@ def main() -> int:
     if not args:
         print(__doc__, file=sys.stderr)
         return 2
-    # Every folder is read before anything is printed: no partial table on an error.
-    for d in args:
-        try:
-            tables([Path(d)], parts)
-        except (OSError, KeyError, ValueError, TypeError, ZeroDivisionError) as e:
-            what = f"no {e.args[0]!r} in it" if isinstance(e, KeyError) else str(e)
-            print(f"{d}: cannot read manifest.json: {what}", file=sys.stderr)
-            return 1
-    print("\n".join(tables([Path(d) for d in args], parts)))
+    # Every folder is read (once) before anything is printed: no partial table on an error.
+    folders = [Path(d) for d in args]
+    try:
+        out = tables(folders, parts)
+    except (OSError, KeyError, ValueError, TypeError, ZeroDivisionError) as e:
+        bad = next(d for d in folders if not readable(d, parts))
+        what = f"no {e.args[0]!r} in it" if isinstance(e, KeyError) else str(e)
+        print(f"{bad}: cannot read manifest.json: {what}", file=sys.stderr)
+        return 1
+    print("\n".join(out))
     return 0
 
 

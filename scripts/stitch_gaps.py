@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from frame_strain import data_file, quantile, read_manifest, read_obj, scene_cloth  # noqa: E402
+from frame_strain import data_file, frames_of, quantile, read_manifest, scene_cloth  # noqa: E402
 
 
 def read_stitches(path: Path):
@@ -72,12 +72,7 @@ def main(argv):
     for folder in folders:
         m, stitches = stitches_of(folder)
         rows = {}
-        for k in range(first, min(last, m.get("complete_frames", 0)) + 1):
-            frame = folder / f"frame_{k:04d}.obj"
-            if not frame.is_file():
-                raise SystemExit(f"{frame}: missing, though the manifest counts "
-                                 f"{m['complete_frames']} complete frames")
-            x, _, _, _ = read_obj(frame)
+        for k, frame, x in frames_of(folder, m, first, last):
             if max(max(s[:3]) for s in stitches) >= len(x):
                 raise SystemExit(f"{frame}: {len(x)} vertices, fewer than "
                                  "the stitches refer to")
