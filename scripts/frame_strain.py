@@ -92,7 +92,8 @@ def read_obj(path: Path, want_vt: bool = False):
 
 
 def frames_of(folder: Path, m: dict, first: int, last: int):
-    """(k, positions) of the folder's frames first..last that its manifest counts complete."""
+    """(k, frame file, positions) of the folder's frames first..last that its manifest counts
+    complete."""
     for k in range(first, min(last, m.get("complete_frames", 0)) + 1):
         frame = folder / f"frame_{k:04d}.obj"
         if not frame.is_file():

@@ -153,14 +153,6 @@ def tables(folders: list[Path], parts: bool) -> list[str]:
     return out
 
 
-def readable(folder: Path, parts: bool) -> bool:
-    try:
-        tables([folder], parts)
-        return True
-    except (OSError, KeyError, ValueError, TypeError, ZeroDivisionError):
-        return False
-
-
 def main() -> int:
     args = sys.argv[1:]
     parts = "--parts" in args
@@ -170,13 +162,19 @@ def main() -> int:
         return 2
     # Every folder is read (once) before anything is printed: no partial table on an error.
     folders = [Path(d) for d in args]
+    errors = (OSError, KeyError, ValueError, TypeError, ZeroDivisionError)
     try:
         out = tables(folders, parts)
-    except (OSError, KeyError, ValueError, TypeError, ZeroDivisionError) as e:
-        bad = next(d for d in folders if not readable(d, parts))
-        what = f"no {e.args[0]!r} in it" if isinstance(e, KeyError) else str(e)
-        print(f"{bad}: cannot read manifest.json: {what}", file=sys.stderr)
-        return 1
+    except errors:
+        # Name the first folder that fails on its own, with its own error.
+        for d in folders:
+            try:
+                tables([d], parts)
+            except errors as e:
+                what = f"no {e.args[0]!r} in it" if isinstance(e, KeyError) else str(e)
+                print(f"{d}: cannot read manifest.json: {what}", file=sys.stderr)
+                return 1
+        raise
     print("\n".join(out))
     return 0
 

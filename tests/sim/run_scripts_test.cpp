@@ -206,6 +206,22 @@ TEST(SimSummaryScript, RowOfAHandMadeRun) {
   EXPECT_NE(b.output.find("bad: cannot read manifest.json: no 'frames' in it"), std::string::npos)
       << b.output;
   EXPECT_EQ(b.output.find("| scene |"), std::string::npos) << "no partial output: " << b.output;
+  // A folder that fails only in the strain table, before one that fails in the first: the
+  // message names the first with its own error, not the other's.
+  fs::create_directories(base / "late");
+  write(base / "late" / "manifest.json",
+        "{\"scene\": \"tiny\", \"complete_frames\": 1, \"initial_self_intersections\": 0, "
+        "\"initial_body_intersections\": 0, \"frames\": ["
+        "{\"frame\": 1, \"seconds\": 2, \"collision_seconds\": 1, \"substeps\": 4, "
+        "\"self_intersections\": 0, \"body_intersections\": 0, \"unresolved_ccd_hits\": 0, "
+        "\"strain\": {\"median\": 0.01, \"p99\": 0.02, \"p999\": 0.03, \"max\": 0.04}}]}");
+  const ScriptRun l =
+      summary("'" + (base / "late").string() + "' '" + (base / "bad").string() + "'");
+  EXPECT_NE(l.status, 0) << l.output;
+  EXPECT_NE(l.output.find("late: cannot read manifest.json: no 'max_site' in it"),
+            std::string::npos)
+      << l.output;
+  EXPECT_EQ(l.output.find("| scene |"), std::string::npos) << "no partial output: " << l.output;
   fs::remove_all(base);
 }
 
